@@ -1,0 +1,71 @@
+# Helpers that give every Aerie target the same shape (ARCHITECTURE.md):
+# a library per component (the algorithm, no LCM unless it is a bus helper) and
+# thin executables around it. Includes are rooted at the repository top:
+#   #include "common/geometry/se3.hpp"
+
+add_library(aerie_warnings INTERFACE)
+target_compile_options(aerie_warnings INTERFACE -Wall -Wextra -Wpedantic
+  $<$<BOOL:${AERIE_WERROR}>:-Werror>)
+
+# aerie_library(NAME SOURCES ... [PUBLIC deps...] [PRIVATE deps...])
+function(aerie_library name)
+  cmake_parse_arguments(A "" "" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
+  if(A_SOURCES)
+    add_library(${name} STATIC ${A_SOURCES})
+    target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+    target_link_libraries(${name} PUBLIC ${A_PUBLIC} PRIVATE aerie_warnings ${A_PRIVATE})
+  else()
+    add_library(${name} INTERFACE)
+    target_include_directories(${name} INTERFACE ${PROJECT_SOURCE_DIR})
+    target_link_libraries(${name} INTERFACE ${A_PUBLIC})
+  endif()
+endfunction()
+
+# aerie_executable(NAME SOURCES ... [LIBS deps...]) -> installed in bin/
+function(aerie_executable name)
+  cmake_parse_arguments(A "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${A_SOURCES})
+  target_link_libraries(${name} PRIVATE aerie_warnings ${A_LIBS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin)
+  install(TARGETS ${name} RUNTIME DESTINATION bin)
+endfunction()
+
+# aerie_test(NAME SOURCES ... [LIBS deps...] [LABELS l...] [TIMEOUT s] [XVFB] [SERIAL])
+# A GoogleTest executable; its tests are discovered at test time so that ctest
+# runs and reports each TEST separately. XVFB runs it under `xvfb-run -a`
+# (off-screen rendering); SERIAL keeps it from running beside other tests.
+function(aerie_test name)
+  cmake_parse_arguments(A "XVFB;SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${A_SOURCES})
+  target_link_libraries(${name} PRIVATE aerie_warnings aerie_test_support GTest::gtest_main
+                        ${A_LIBS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  if(NOT A_TIMEOUT)
+    set(A_TIMEOUT 300)
+  endif()
+  set(props TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}")
+  if(A_SERIAL)
+    list(APPEND props RUN_SERIAL TRUE)
+  endif()
+  if(A_XVFB)
+    find_program(XVFB_RUN xvfb-run REQUIRED)
+    add_test(NAME ${name} COMMAND ${XVFB_RUN} -a $<TARGET_FILE:${name}>)
+    set_tests_properties(${name} PROPERTIES ${props})
+  else()
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
+                         PROPERTIES ${props})
+  endif()
+endfunction()
+
+# Adds every immediate subfolder that has a CMakeLists.txt, so a new component
+# needs no edit of its parent.
+function(aerie_add_subdirectories)
+  file(GLOB children LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR}
+       CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*)
+  list(SORT children)
+  foreach(child ${children})
+    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${child}/CMakeLists.txt)
+      add_subdirectory(${child})
+    endif()
+  endforeach()
+endfunction()

@@ -1,0 +1,66 @@
+#include "common/bus/bus.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <sys/select.h>
+
+namespace aerie::bus {
+
+void Subscription::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  ++counters_.received;
+  try {
+    dispatch(rbuf, channel);
+  } catch (const std::invalid_argument& e) {
+    ++counters_.malformed;
+    last_error_ = channel + ": " + e.what();
+    spdlog::warn("dropped message on {}: {}", channel, e.what());
+  } catch (const std::exception& e) {
+    ++counters_.handler_errors;
+    last_error_ = channel + ": " + e.what();
+    spdlog::error("handler for {} failed: {}", channel, e.what());
+  }
+}
+
+void Subscription::note_seq(int64_t seq) {
+  // A seq at or below the last one is a restarted publisher or a replayed log: resynchronise.
+  if (last_seq_ >= 0 && seq > last_seq_ + 1) counters_.sequence_gaps += seq - last_seq_ - 1;
+  last_seq_ = seq;
+}
+
+namespace {
+std::string resolve_url(const std::string& url) {
+  if (!url.empty()) return url;
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  return env ? env : "";
+}
+}  // namespace
+
+Bus::Bus(const std::string& url) : url_(resolve_url(url)), lcm_(url_) {
+  if (!lcm_.good())
+    throw std::runtime_error("cannot start LCM on '" + (url_.empty() ? std::string("default URL") : url_) +
+                             "' (multicast route missing? try: ip route add 224.0.0.0/4 dev lo)");
+}
+
+Bus::~Bus() {
+  for (auto& s : subs_)
+    if (s->handle_) lcm_.unsubscribe(s->handle_);
+}
+
+Subscription& Bus::attach(std::unique_ptr<Subscription> sub, const std::string& channel, int queue_capacity) {
+  sub->channel_ = channel;
+  sub->handle_ = lcm_.subscribe(channel, &Subscription::on_raw, sub.get());
+  if (!sub->handle_) throw std::runtime_error("cannot subscribe to " + channel);
+  sub->handle_->setQueueCapacity(queue_capacity);
+  subs_.push_back(std::move(sub));
+  return *subs_.back();
+}
+
+int Bus::handle(int timeout_ms) {
+  const int r = lcm_.handleTimeout(timeout_ms);
+  if (r < 0 && errno != EINTR) throw std::runtime_error("LCM handle failed on " + url_);
+  return r < 0 ? 0 : r;
+}
+
+}  // namespace aerie::bus

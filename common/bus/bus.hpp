@@ -1,0 +1,115 @@
+#pragma once
+// Typed publish/subscribe over LCM 1.3, whose C++ API has no lambda subscribe.
+// A subscription decodes the message itself, so a corrupt payload is counted and
+// logged instead of reaching the handler; a handler that throws is counted too.
+// Gaps in `seq` are counted as drops (LCM drops silently when a queue is full).
+#include <lcm/lcm-cpp.hpp>
+
+#include <atomic>
+#include <concepts>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace aerie::bus {
+
+struct ChannelCounters {
+  std::atomic<int64_t> received{0};
+  std::atomic<int64_t> malformed{0};        // failed to decode
+  std::atomic<int64_t> handler_errors{0};   // handler threw
+  std::atomic<int64_t> sequence_gaps{0};    // messages missing according to seq
+};
+
+struct ReceiveInfo {
+  std::string channel;
+  int64_t recv_utime = 0;  // wall clock at reception (LCM's)
+  size_t bytes = 0;
+};
+
+class Subscription {
+ public:
+  virtual ~Subscription() = default;
+  const std::string& channel() const { return channel_; }
+  const ChannelCounters& counters() const { return counters_; }
+  const std::string& last_error() const { return last_error_; }
+
+ protected:
+  friend class Bus;
+  void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  virtual void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) = 0;
+  void note_seq(int64_t seq);
+
+  std::string channel_;
+  ChannelCounters counters_;
+  std::string last_error_;
+  int64_t last_seq_ = -1;
+  lcm::Subscription* handle_ = nullptr;
+};
+
+template <typename Msg>
+concept HasSeq = requires(Msg m) {
+  { m.seq } -> std::convertible_to<int64_t>;
+};
+
+template <typename Msg>
+class TypedSubscription final : public Subscription {
+ public:
+  using Handler = std::function<void(const Msg&, const ReceiveInfo&)>;
+  explicit TypedSubscription(Handler h) : handler_(std::move(h)) {}
+
+ private:
+  void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
+    Msg msg;
+    if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0)
+      throw std::invalid_argument("cannot decode " + std::string(Msg::getTypeName()) + " (" +
+                                  std::to_string(rbuf->data_size) + " bytes; wrong type or corrupt payload)");
+    if constexpr (HasSeq<Msg>) note_seq(msg.seq);
+    handler_(msg, ReceiveInfo{channel, rbuf->recv_utime, rbuf->data_size});
+  }
+  Handler handler_;
+};
+
+class Bus {
+ public:
+  // url "" = LCM_DEFAULT_URL or LCM's default. Throws std::runtime_error if LCM cannot start.
+  explicit Bus(const std::string& url = "");
+  Bus(const Bus&) = delete;
+  Bus& operator=(const Bus&) = delete;
+  ~Bus();
+
+  template <typename Msg>
+  void publish(const std::string& channel, const Msg& msg) {
+    if (lcm_.publish(channel, &msg) != 0) {
+      ++publish_errors_;
+    }
+  }
+
+  // queue_capacity: messages LCM keeps for this subscription before dropping the newest.
+  template <typename Msg>
+  Subscription& subscribe(const std::string& channel, typename TypedSubscription<Msg>::Handler handler,
+                          int queue_capacity = 30) {
+    auto sub = std::make_unique<TypedSubscription<Msg>>(std::move(handler));
+    return attach(std::move(sub), channel, queue_capacity);
+  }
+
+  // Handles messages for up to timeout_ms; returns how many were handled (0 on timeout).
+  int handle(int timeout_ms);
+  int fileno() { return lcm_.getFileno(); }
+  lcm::LCM& raw() { return lcm_; }
+  const std::string& url() const { return url_; }
+  const std::vector<std::unique_ptr<Subscription>>& subscriptions() const { return subs_; }
+  int64_t publish_errors() const { return publish_errors_; }
+
+ private:
+  Subscription& attach(std::unique_ptr<Subscription> sub, const std::string& channel, int queue_capacity);
+
+  std::string url_;
+  lcm::LCM lcm_;
+  std::vector<std::unique_ptr<Subscription>> subs_;
+  std::atomic<int64_t> publish_errors_{0};
+};
+
+}  // namespace aerie::bus

@@ -1,0 +1,140 @@
+#include "common/image/image_message.hpp"
+
+#include <charconv>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace aerie::image {
+
+Encoding encoding_from_string(const std::string& name) {
+  if (name == "raw") return Encoding::Raw;
+  if (name == "jpeg" || name == "jpg") return Encoding::Jpeg;
+  if (name == "png") return Encoding::Png;
+  throw std::invalid_argument("unknown image encoding '" + name + "' (expected raw, jpeg or png)");
+}
+
+std::string pixel_format_name(int32_t f) {
+  switch (f) {
+    case aerie::image_t::PIXEL_FORMAT_GRAY: return "GRAY";
+    case aerie::image_t::PIXEL_FORMAT_RGB: return "RGB";
+    case aerie::image_t::PIXEL_FORMAT_BGR: return "BGR";
+    case aerie::image_t::PIXEL_FORMAT_MJPEG: return "MJPEG";
+    case aerie::image_t::PIXEL_FORMAT_PNG: return "PNG";
+    default: return "unknown(" + std::to_string(f) + ")";
+  }
+}
+
+aerie::image_t to_message(const cv::Mat& img, int64_t utime, int64_t seq, Encoding encoding, int jpeg_quality) {
+  if (img.empty()) throw std::invalid_argument("to_message: empty image");
+  if (img.type() != CV_8UC1 && img.type() != CV_8UC3)
+    throw std::invalid_argument("to_message: only 8-bit gray or BGR images are supported");
+  aerie::image_t msg;
+  msg.utime = utime;
+  msg.width = img.cols;
+  msg.height = img.rows;
+  msg.nmetadata = 0;
+  if (encoding == Encoding::Raw) {
+    msg.pixelformat = img.channels() == 1 ? int32_t{aerie::image_t::PIXEL_FORMAT_GRAY} : int32_t{aerie::image_t::PIXEL_FORMAT_BGR};
+    msg.row_stride = static_cast<int32_t>(img.cols * img.elemSize());
+    msg.data.resize(static_cast<size_t>(msg.row_stride) * img.rows);
+    for (int r = 0; r < img.rows; ++r)
+      std::memcpy(msg.data.data() + static_cast<size_t>(r) * msg.row_stride, img.ptr(r), msg.row_stride);
+  } else {
+    std::vector<uchar> buf;
+    const bool jpeg = encoding == Encoding::Jpeg;
+    std::vector<int> params;
+    if (jpeg) params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
+    if (!cv::imencode(jpeg ? ".jpg" : ".png", img, buf, params))
+      throw std::runtime_error("to_message: image encoding failed");
+    msg.pixelformat = jpeg ? int32_t{aerie::image_t::PIXEL_FORMAT_MJPEG} : int32_t{aerie::image_t::PIXEL_FORMAT_PNG};
+    msg.row_stride = 0;
+    msg.data.assign(buf.begin(), buf.end());
+  }
+  msg.size = static_cast<int32_t>(msg.data.size());
+  set_metadata(msg, "seq", std::to_string(seq));
+  return msg;
+}
+
+cv::Mat from_message(const aerie::image_t& msg) {
+  auto bad = [&](const std::string& what) {
+    throw std::invalid_argument("image message (utime " + std::to_string(msg.utime) + ", " +
+                                pixel_format_name(msg.pixelformat) + "): " + what);
+  };
+  if (msg.width <= 0 || msg.height <= 0)
+    bad("invalid size " + std::to_string(msg.width) + "x" + std::to_string(msg.height));
+  if (msg.size != static_cast<int32_t>(msg.data.size())) bad("size field disagrees with the payload length");
+  switch (msg.pixelformat) {
+    case aerie::image_t::PIXEL_FORMAT_GRAY:
+    case aerie::image_t::PIXEL_FORMAT_RGB:
+    case aerie::image_t::PIXEL_FORMAT_BGR: {
+      const int channels = msg.pixelformat == aerie::image_t::PIXEL_FORMAT_GRAY ? 1 : 3;
+      const int64_t row_bytes = static_cast<int64_t>(msg.width) * channels;
+      if (msg.row_stride < row_bytes) bad("row_stride " + std::to_string(msg.row_stride) + " is shorter than a row");
+      if (static_cast<int64_t>(msg.row_stride) * msg.height > msg.size)
+        bad("payload of " + std::to_string(msg.size) + " bytes is too short for " + std::to_string(msg.height) +
+            " rows of stride " + std::to_string(msg.row_stride));
+      const cv::Mat view(msg.height, msg.width, channels == 1 ? CV_8UC1 : CV_8UC3,
+                         const_cast<uint8_t*>(msg.data.data()), static_cast<size_t>(msg.row_stride));
+      cv::Mat out;
+      if (msg.pixelformat == aerie::image_t::PIXEL_FORMAT_RGB)
+        cv::cvtColor(view, out, cv::COLOR_RGB2BGR);
+      else
+        out = view.clone();
+      return out;
+    }
+    case aerie::image_t::PIXEL_FORMAT_MJPEG:
+    case aerie::image_t::PIXEL_FORMAT_PNG: {
+      const cv::Mat buf(1, msg.size, CV_8UC1, const_cast<uint8_t*>(msg.data.data()));
+      cv::Mat out = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
+      if (out.empty()) bad("payload cannot be decoded");
+      if (out.cols != msg.width || out.rows != msg.height)
+        bad("decoded image is " + std::to_string(out.cols) + "x" + std::to_string(out.rows) + ", header says " +
+            std::to_string(msg.width) + "x" + std::to_string(msg.height));
+      if (out.depth() != CV_8U) bad("only 8-bit images are supported");
+      if (out.channels() == 4) cv::cvtColor(out, out, cv::COLOR_BGRA2BGR);
+      return out;
+    }
+    default: bad("unsupported pixel format");
+  }
+  return {};
+}
+
+cv::Mat gray_from_message(const aerie::image_t& msg) {
+  cv::Mat img = from_message(msg);
+  if (img.channels() == 3) cv::cvtColor(img, img, cv::COLOR_BGR2GRAY);
+  return img;
+}
+
+void set_metadata(aerie::image_t& msg, const std::string& key, const std::string& value) {
+  for (auto& m : msg.metadata) {
+    if (m.key == key) {
+      m.value.assign(value.begin(), value.end());
+      m.n = static_cast<int32_t>(m.value.size());
+      return;
+    }
+  }
+  aerie::image_metadata_t m;
+  m.key = key;
+  m.value.assign(value.begin(), value.end());
+  m.n = static_cast<int32_t>(m.value.size());
+  msg.metadata.push_back(m);
+  msg.nmetadata = static_cast<int32_t>(msg.metadata.size());
+}
+
+std::optional<std::string> metadata(const aerie::image_t& msg, const std::string& key) {
+  for (const auto& m : msg.metadata)
+    if (m.key == key) return std::string(m.value.begin(), m.value.end());
+  return std::nullopt;
+}
+
+int64_t sequence_number(const aerie::image_t& msg) {
+  const auto s = metadata(msg, "seq");
+  if (!s) return -1;
+  int64_t v = -1;
+  const auto [p, ec] = std::from_chars(s->data(), s->data() + s->size(), v);
+  return (ec == std::errc() && p == s->data() + s->size()) ? v : -1;
+}
+
+}  // namespace aerie::image

@@ -1,0 +1,33 @@
+#pragma once
+// cv::Mat <-> aerie::image_t (bot_core.image_t layout): raw GRAY/RGB/BGR, JPEG, PNG.
+#include <aerie/image_t.hpp>
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+
+namespace aerie::image {
+
+enum class Encoding { Raw, Jpeg, Png };
+Encoding encoding_from_string(const std::string& name);  // "raw", "jpeg", "png"; throws otherwise
+
+// img: CV_8UC1 (GRAY) or CV_8UC3 in OpenCV's BGR order. Raw colour is sent as BGR.
+aerie::image_t to_message(const cv::Mat& img, int64_t utime, int64_t seq, Encoding encoding = Encoding::Raw,
+                          int jpeg_quality = 90);
+
+// Decodes any supported payload to CV_8UC1 or CV_8UC3 (BGR). Throws
+// std::invalid_argument naming what is inconsistent (size vs width*height, unknown
+// pixel format, undecodable JPEG/PNG, ...). The result never aliases msg.data.
+cv::Mat from_message(const aerie::image_t& msg);
+// As from_message, converted to 8-bit gray.
+cv::Mat gray_from_message(const aerie::image_t& msg);
+
+std::string pixel_format_name(int32_t pixelformat);
+
+void set_metadata(aerie::image_t& msg, const std::string& key, const std::string& value);
+std::optional<std::string> metadata(const aerie::image_t& msg, const std::string& key);
+// metadata["seq"], or -1 when absent or not a number.
+int64_t sequence_number(const aerie::image_t& msg);
+
+}  // namespace aerie::image

@@ -1,0 +1,78 @@
+#include <gtest/gtest.h>
+
+#include <aerie/pose_t.hpp>
+
+#include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
+#include "common/image/image_message.hpp"
+
+using aerie::bus::Bus;
+using aerie::bus::ReceiveInfo;
+
+TEST(Bus, TypedRoundTripOverMemq) {
+  Bus bus("memq://");
+  std::vector<int64_t> got;
+  bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t& m, const ReceiveInfo& info) {
+    got.push_back(m.seq);
+    EXPECT_EQ(info.channel, "VO_POSE");
+  });
+  for (int64_t s : {0, 1, 2, 5}) {  // 3 and 4 are "lost"
+    aerie::pose_t p{};
+    p.seq = s;
+    bus.publish("VO_POSE", p);
+  }
+  while (bus.handle(0) > 0) {
+  }
+  EXPECT_EQ(got, (std::vector<int64_t>{0, 1, 2, 5}));
+  EXPECT_EQ(bus.subscriptions()[0]->counters().sequence_gaps, 2);
+}
+
+TEST(Bus, CorruptPayloadIsCountedNotDelivered) {
+  Bus bus("memq://");
+  int delivered = 0;
+  auto& sub = bus.subscribe<aerie::image_t>("CAM_LEFT", [&](const aerie::image_t&, const ReceiveInfo&) { ++delivered; });
+  const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
+  bus.raw().publish("CAM_LEFT", junk, sizeof(junk));
+  aerie::pose_t wrong_type{};
+  bus.publish("CAM_LEFT", wrong_type);  // fingerprint mismatch
+  while (bus.handle(0) > 0) {
+  }
+  EXPECT_EQ(delivered, 0);
+  EXPECT_EQ(sub.counters().malformed, 2);
+  EXPECT_NE(sub.last_error().find("image_t"), std::string::npos) << sub.last_error();
+}
+
+TEST(Bus, HandlerExceptionIsCountedAndStatusReportsIt) {
+  Bus bus("memq://");
+  bus.subscribe<aerie::pose_t>("VO_POSE", [](const aerie::pose_t&, const ReceiveInfo&) {
+    throw std::runtime_error("boom");
+  });
+  aerie::process_status_t last{};
+  int statuses = 0;
+  aerie::bus::StatusReporter status(bus, "test-node");
+  EXPECT_EQ(status.channel(), "STATUS_TEST_NODE");
+  bus.subscribe<aerie::process_status_t>(status.channel(), [&](const aerie::process_status_t& m, const ReceiveInfo&) {
+    last = m;
+    ++statuses;
+  });
+  bus.publish("VO_POSE", aerie::pose_t{});
+  while (bus.handle(0) > 0) {
+  }
+  status.count("frames", 3);
+  status.publish_now();
+  while (bus.handle(0) > 0) {
+  }
+  ASSERT_EQ(statuses, 1);
+  auto value = [&](const std::string& name) {
+    for (int i = 0; i < last.ncounters; ++i)
+      if (last.counter_names[i] == name) return last.counter_values[i];
+    return int64_t{-1};
+  };
+  EXPECT_EQ(value("frames"), 3);
+  EXPECT_EQ(value("VO_POSE.handler_errors"), 1);
+  EXPECT_EQ(value("VO_POSE.received"), 1);
+}
+
+TEST(Bus, BadUrlIsAClearError) {
+  EXPECT_THROW(Bus("nosuchprovider://x"), std::runtime_error);
+}
