@@ -70,7 +70,7 @@ IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
   const cv::Size sky_size(cfg.width + 2 * margin, cfg.height + 2 * margin);
   const cv::Mat n = value_noise(sky_size, 0.5 * sky_size.width, 7, 0.55, mix_seed(cfg.seed, 12));
   sky_.create(sky_size, CV_32FC3);
-  const double cover = rng.uniform(0.45, 0.6);
+  const double cover = rng.uniform(0.38, 0.5);
   for (int y = 0; y < sky_size.height; ++y) {
     const double h = static_cast<double>(y) / sky_size.height;
     const cv::Vec3f blue(static_cast<float>(200 + 40 * h), static_cast<float>(140 + 60 * h),
@@ -109,14 +109,14 @@ IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
   cv::Mat paint(side, side, CV_32FC3);
   for (int y = 0; y < side; ++y)
     for (int x = 0; x < side; ++x) {
-      const float g = static_cast<float>(120 + 90 * body.at<float>(y, x));
+      const float g = static_cast<float>(40 + 110 * body.at<float>(y, x));
       paint.at<cv::Vec3f>(y, x) = cv::Vec3f(g, g, g);
     }
   // Markings: a dark stripe along the fuselage, roundels on the wings, a dark tail band.
   cv::line(paint, to_sprite({-0.4, 0.0}), to_sprite({0.4, 0.0}), cv::Scalar(60, 40, 150), 10, cv::LINE_AA);
   for (double s : {-1.0, 1.0}) {
     cv::circle(paint, to_sprite({-0.04, s * 0.36}), 22, cv::Scalar(150, 60, 30), cv::FILLED, cv::LINE_AA);
-    cv::circle(paint, to_sprite({-0.04, s * 0.36}), 10, cv::Scalar(240, 240, 240), cv::FILLED, cv::LINE_AA);
+    cv::circle(paint, to_sprite({-0.04, s * 0.36}), 10, cv::Scalar(230, 230, 230), cv::FILLED, cv::LINE_AA);
     cv::line(paint, to_sprite({0.0, s * 0.5}), to_sprite({0.1, s * 0.08}), cv::Scalar(40, 40, 40), 6, cv::LINE_AA);
   }
   cv::rectangle(paint, to_sprite({-0.43, 0.17}), to_sprite({-0.39, -0.17}), cv::Scalar(40, 40, 40), cv::FILLED);
@@ -162,7 +162,7 @@ MonoFrame IntruderScene::frame(int k) const {
   cv::Mat plane, alpha;
   cv::warpAffine(sprite_, plane, M, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   cv::warpAffine(sprite_alpha_, alpha, M, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-  for (int y = 0; y < size.height; ++y) {
+  for (int y = 0; y < size.height && config_.draw_target; ++y) {
     auto* dst = img.ptr<cv::Vec3f>(y);
     const auto* src = plane.ptr<cv::Vec3f>(y);
     const float* a = alpha.ptr<float>(y);

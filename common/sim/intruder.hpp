@@ -22,6 +22,7 @@ struct IntruderConfig {
   double max_roll_deg = 12.0;    // amplitude of the slow in-image rotation (bank)
   double noise_sigma = 1.5;      // additive Gaussian image noise (grey levels)
   bool color = false;            // BGR instead of gray
+  bool draw_target = true;       // false: the same frames without the aircraft (background)
 };
 
 struct MonoFrame {
