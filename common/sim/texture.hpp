@@ -26,8 +26,9 @@ class MipTexture {
     const cv::Mat& m = levels_[k];
     const float s = scale_[k];
     float x = u * s, y = v * s;
-    x = std::fmin(std::fmax(x, 0.f), static_cast<float>(m.cols - 1));
-    y = std::fmin(std::fmax(y, 0.f), static_cast<float>(m.rows - 1));
+    const float xmax = static_cast<float>(m.cols - 1), ymax = static_cast<float>(m.rows - 1);
+    x = x < 0.f ? 0.f : (x > xmax ? xmax : x);
+    y = y < 0.f ? 0.f : (y > ymax ? ymax : y);
     const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
     const int x1 = x0 + (x0 + 1 < m.cols), y1 = y0 + (y0 + 1 < m.rows);
     const float fx = x - x0, fy = y - y0;
