@@ -51,7 +51,7 @@ WorldConfig load_world_config(const util::Config& c) {
 RigConfig load_rig_config(const util::Config& c) {
   check_keys(c, {"width", "height", "baseline", "hfov_deg", "vfov_deg", "pitch_deg", "color", "noise_sigma",
                  "exposure", "illumination_amplitude", "illumination_period", "right_gain", "disparity",
-                 "noise_seed"});
+                 "noise_seed", "motion_blur_samples", "exposure_time"});
   RigConfig r;
   read(c, "width", r.width);
   read(c, "height", r.height);
@@ -67,6 +67,8 @@ RigConfig load_rig_config(const util::Config& c) {
   read(c, "right_gain", r.right_gain);
   read(c, "disparity", r.disparity);
   read(c, "noise_seed", r.noise_seed);
+  read(c, "motion_blur_samples", r.motion_blur_samples);
+  read(c, "exposure_time", r.exposure_time);
   return r;
 }
 

@@ -72,6 +72,8 @@ StereoRenderer::StereoRenderer(const World& world, const RigConfig& rig) : world
   check(rig.illumination_amplitude >= 0 && rig.illumination_amplitude < 1,
         "illumination_amplitude must be in [0, 1)");
   check(rig.illumination_period > 0, "illumination_period must be > 0");
+  check(rig.motion_blur_samples >= 0 && rig.motion_blur_samples <= 64, "motion_blur_samples must be in [0, 64]");
+  check(rig.exposure_time > 0, "exposure_time must be > 0");
   K_.width = rig.width;
   K_.height = rig.height;
   K_.fx = 0.5 * rig.width / std::tan(0.5 * rig.hfov_deg * kPi / 180.0);
@@ -280,15 +282,32 @@ void StereoRenderer::project_helipad(const geometry::SE3& T_world_left, StereoFr
     f.target_box = cv::Rect2d();
 }
 
-StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq) const {
+StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
+                                   const std::vector<geometry::SE3>& blur_poses) const {
   StereoFrame f;
   f.utime = utime;
   f.seq = seq;
   f.T_world_left = T_world_left;
   cv::Mat rad_left, rad_right;
-  render_view(T_world_left, rad_left, &f.depth);
   const geometry::SE3 T_left_right(Eigen::Quaterniond::Identity(), Eigen::Vector3d(rig_.baseline, 0, 0));
-  render_view(T_world_left * T_left_right, rad_right, nullptr);
+  if (blur_poses.empty()) {
+    render_view(T_world_left, rad_left, &f.depth);
+    render_view(T_world_left * T_left_right, rad_right, nullptr);
+  } else {
+    // Motion blur: the sensor integrates the radiance over the exposure.
+    render_view(T_world_left, rad_left, &f.depth);
+    rad_left.setTo(0);
+    rad_right = cv::Mat::zeros(rad_left.size(), rad_left.type());
+    cv::Mat l, r;
+    for (const auto& T : blur_poses) {
+      render_view(T, l, nullptr);
+      render_view(T * T_left_right, r, nullptr);
+      rad_left += l;
+      rad_right += r;
+    }
+    rad_left /= static_cast<double>(blur_poses.size());
+    rad_right /= static_cast<double>(blur_poses.size());
+  }
 
   // Photometry: exposure, slow illumination change, right camera gain, noise.
   const double t = utime * 1e-6;

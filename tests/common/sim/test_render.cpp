@@ -270,6 +270,28 @@ TEST(SimRender, PhotometricOptions) {
   EXPECT_NEAR(cv::mean(bright.left)[0], 1.3 * cv::mean(base.left)[0], 2.0);
 }
 
+TEST(SimRender, MotionBlurSmoothsTheImagesNotTheGroundTruth) {
+  const World& w = test::light_world();
+  RigConfig rig;
+  const Trajectory demo = Trajectory::demo_flight(w);
+  const StereoSimulation sharp(w, rig, demo);
+  rig.motion_blur_samples = 8;
+  rig.exposure_time = 0.05;
+  const StereoSimulation blurred(w, rig, demo);
+  const int k = 400;  // cruising along the survey loop
+  const StereoFrame a = sharp.frame(k), b = blurred.frame(k);
+  EXPECT_EQ(cv::norm(a.depth, b.depth, cv::NORM_INF), 0.0);
+  EXPECT_EQ(a.target_box, b.target_box);
+  auto gradient_energy = [](const cv::Mat& img) {
+    cv::Mat gx;
+    cv::Sobel(img, gx, CV_32F, 1, 0);
+    return cv::norm(gx, cv::NORM_L1);
+  };
+  EXPECT_LT(gradient_energy(b.left), 0.95 * gradient_energy(a.left));
+  EXPECT_LT(gradient_energy(b.right), 0.95 * gradient_energy(a.right));
+  EXPECT_NEAR(cv::mean(b.left)[0], cv::mean(a.left)[0], 2.0);  // same light
+}
+
 TEST(SimRender, TexturesGiveFastCornersEverywhere) {
   const World& w = test::default_world();
   StereoSimulation sim(w, RigConfig{}, Trajectory::demo_flight(w));
