@@ -78,7 +78,7 @@ class MessageBuilder {
   FrameMessages build(const Frame& frame, int64_t utime, int64_t seq) const;
 
  private:
-  const CaptureConfig& cfg_;
+  CaptureConfig cfg_;
   bool stereo_;
   std::optional<camera::RectifiedStereo> rectified_;
   image::Encoding encoding_;

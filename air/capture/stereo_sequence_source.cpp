@@ -113,15 +113,8 @@ StereoSequence load_kitti(const std::string& dir) {
   } catch (const FrameError& e) {
     throw std::runtime_error(e.what());
   }
-  const std::string calib_file = (root / "calib.txt").string();
-  s.calib = camera::read_kitti_stereo(calib_file, first.cols, first.rows);
-  // KITTI calib.txt has no image size: at least the principal point must lie in the image.
-  const auto& c = s.calib.left;
-  if (c.cx <= 0 || c.cx >= first.cols || c.cy <= 0 || c.cy >= first.rows)
-    throw std::runtime_error(calib_file + ": principal point (" + std::to_string(c.cx) + ", " + std::to_string(c.cy) +
-                             ") lies outside the " + size_str(first.size()) + " image " + s.left[0] +
-                             " (calibration of another camera?)");
-
+  // calib.txt has no image size: the reader checks the principal point against the images'.
+  s.calib = camera::read_kitti_stereo((root / "calib.txt").string(), first.cols, first.rows);
   const fs::path times = root / "times.txt";
   if (fs::exists(times)) {
     s.utimes = read_timestamps(times.string());
