@@ -47,6 +47,7 @@ struct Accumulator {
   ChannelSummary s;
   std::vector<std::string> types;
   std::optional<int64_t> last_seq;
+  int64_t undecodable_since_seq = 0;  // corrupt messages since the last good seq
 };
 
 }  // namespace
@@ -93,15 +94,19 @@ LogSummary summarize(const std::string& path, bool resync) {
     const Stamp st = type->decode(ev.data.data(), ev.data.size());
     if (!st.decoded) {
       ++c.undecodable;
+      ++a.undecodable_since_seq;
       continue;
     }
     if (!st.seq) continue;
     c.has_seq = true;
     if (a.last_seq) {
-      if (*st.seq > *a.last_seq + 1) c.seq_gaps += *st.seq - *a.last_seq - 1;
+      // A missing seq is a dropped message unless a corrupt message took its place.
+      const int64_t missing = *st.seq - *a.last_seq - 1;
+      if (missing > 0) c.seq_gaps += std::max<int64_t>(0, missing - a.undecodable_since_seq);
       if (*st.seq <= *a.last_seq) ++c.seq_restarts;
     }
     a.last_seq = st.seq;
+    a.undecodable_since_seq = 0;
   }
   out.damage = reader.damage();
   out.duration_s = out.events ? (out.last_utime - out.first_utime) * 1e-6 : 0.0;
