@@ -145,11 +145,6 @@ void OccupancyParams::validate() const {
   require(visibility_if_occluded >= 0 && visibility_if_occluded <= 1, "visibility_if_occluded must be in [0, 1]");
 }
 
-double OccupancyParams::range_sigma(double r) const {
-  if (stereo.disparity_sigma_px <= 0) return 0.0;
-  return r * r * stereo.disparity_sigma_px / (stereo.focal_px * stereo.baseline_m);
-}
-
 OccupancyMap::OccupancyMap(const OccupancyParams& params) : params_(params), frame_(std::make_unique<FrameBuffer>()) {
   params_.validate();
   log_hit_ = logit(params_.sensor_model.hit);
@@ -178,10 +173,20 @@ FrameStats OccupancyMap::insert_depth(const spherical::SphericalDepth& depth, co
   const Eigen::Matrix3f R = T_world_camera.rotation_matrix().cast<float>();
   const Eigen::Vector3f t = T_world_camera.translation().cast<float>();
   for (size_t i = 0; i < depth.size(); ++i) points.push_back(R * depth.point_camera(i) + t);
-  return insert_frame(points, t);
+  OccupancyParams::Stereo stereo = params_.stereo;
+  if (depth.focal_px > 0 && depth.baseline_m > 0) {
+    stereo.focal_px = depth.focal_px;
+    stereo.baseline_m = depth.baseline_m;
+  }
+  return insert(points, t, stereo);
 }
 
-FrameStats OccupancyMap::insert_frame(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin_f) {
+FrameStats OccupancyMap::insert_frame(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin) {
+  return insert(points, origin, params_.stereo);
+}
+
+FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& origin_f,
+                                const OccupancyParams::Stereo& stereo) {
   FrameStats stats;
   stats.points = points.size();
   auto& f = *frame_;
@@ -232,7 +237,7 @@ FrameStats OccupancyMap::insert_frame(const std::vector<Eigen::Vector3f>& points
     const octomap::OcTreeKey key = unpack_key(ray.end);
     const double r = (Eigen::Vector3d(tree.keyToCoord(key[0]), tree.keyToCoord(key[1]), tree.keyToCoord(key[2])) -
                       origin).norm();
-    const double sigma = params_.range_sigma(r);
+    const double sigma = stereo.range_sigma(r);
     const float weight = sigma > 0 ? static_cast<float>(std::erf(res / (2.0 * std::sqrt(2.0) * sigma))) : 1.f;
     f.voxels.mark(key);
     f.updates.push_back({ray.end, std::max(weight, 1e-3f)});
@@ -248,7 +253,7 @@ FrameStats OccupancyMap::insert_frame(const std::vector<Eigen::Vector3f>& points
     const double length = (end - origin).norm();
     if (length <= 0) continue;
     const double free_length =
-        ray.hit ? length - params_.stereo.free_margin_sigmas * params_.range_sigma(length) : length + res;
+        ray.hit ? length - stereo.free_margin_sigmas * stereo.range_sigma(length) : length + res;
     if (free_length <= 0) continue;
     const Eigen::Vector3d direction = (end - origin) / length;
     traverse_keys(origin, direction, free_length, res, 0, [&](const octomap::OcTreeKey& k, double, double t_exit) {

@@ -49,12 +49,14 @@ struct OccupancyParams {
     double baseline_m = 0.12;
     double disparity_sigma_px = 0.5;  // matching noise; 0 disables the depth error model
     double free_margin_sigmas = 2.0;  // free space stops this many sigma_r before a hit
+    // Stereo range error (m) at range r: sigma_r = r^2 sigma_d / (f b).
+    double range_sigma(double r) const {
+      return disparity_sigma_px > 0 ? r * r * disparity_sigma_px / (focal_px * baseline_m) : 0.0;
+    }
   } stereo;
   double visibility_if_occluded = 0.2;  // S&Z P(visible | occluded); 1 disables the visibility term
 
   void validate() const;  // throws std::invalid_argument naming the key
-  // Stereo range error (m) at range r.
-  double range_sigma(double r) const;
 };
 
 enum class Occupancy : int8_t { Unknown = 0, Free = 1, Occupied = 2 };
@@ -101,7 +103,8 @@ class OccupancyMap {
 
   // One frame: points in the world frame and the sensor origin (the robust update above).
   FrameStats insert_frame(const std::vector<Eigen::Vector3f>& points_world, const Eigen::Vector3f& origin);
-  // One frame of spherical depth (VO_DEPTH) seen from T_world_camera.
+  // One frame of spherical depth (VO_DEPTH) seen from T_world_camera; the depth's own
+  // focal length and baseline, when given, replace those of params.stereo.
   FrameStats insert_depth(const spherical::SphericalDepth& depth, const geometry::SE3& T_world_camera);
 
   // Occupancy at p on OctoMap depth `depth` (0 = finest, else 1..16: voxel edge
@@ -133,6 +136,8 @@ class OccupancyMap {
 
  private:
   struct FrameBuffer;
+  FrameStats insert(const std::vector<Eigen::Vector3f>& points_world, const Eigen::Vector3f& origin,
+                    const OccupancyParams::Stereo& stereo);
   OccupancyParams params_;
   std::unique_ptr<MapTree> tree_;
   std::unique_ptr<FrameBuffer> frame_;
