@@ -9,7 +9,13 @@
 namespace aerie::sim {
 namespace {
 constexpr double kRad = std::numbers::pi / 180.0;
+
+inline double wrap180(double a) {
+  while (a >= 180.0) a -= 360.0;
+  while (a < -180.0) a += 360.0;
+  return a;
 }
+}  // namespace
 
 CameraView look_at_wall(const Scene& scene, const CameraParams& camera, double /*x*/, double y, double heading_deg) {
   CameraView v;
@@ -43,10 +49,11 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
   std::deque<std::pair<double, double>> commands;
   const auto cmd_delay_steps = std::lround(cfg.vehicle.command_delay_s / dt);
 
+  // The gust process is sampled at the sensor rate and held over the physics steps.
   const double gust_std = cfg.yaw_gust_std_per_speed * cfg.speed_m_s;
-  const double gust_a = std::exp(-dt / cfg.yaw_gust_time_constant_s);
+  const double gust_a = std::exp(-1.0 / (cfg.sensor.rate_hz * cfg.yaw_gust_time_constant_s));
   const double gust_b = gust_std * std::sqrt(1.0 - gust_a * gust_a);
-  double gust = gust_std * gauss(rng);
+  double gust = gust_std * gauss(rng);  // stationary from the start
   double drift = 0.0;
   const double drift_step = cfg.sensor.drift_deg_per_sqrt_s * std::sqrt(1.0 / cfg.sensor.rate_hz);
 
@@ -64,7 +71,7 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
 
     // Heading error and its integrals over the active phase (true heading).
     if (res.activated) {
-      const double e = std::remainder(res.reference_deg - s.heading_deg, 360.0);
+      const double e = wrap180(res.reference_deg - s.heading_deg);
       const double ta = t - res.activation_time_s;
       res.itse += ta * e * e * dt;
       res.iae += std::abs(e) * dt;
@@ -85,6 +92,7 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
 
     // A heading estimate (and a control period) every `physics_substeps` steps.
     if (k % cfg.physics_substeps == 0) {
+      gust = gust_a * gust + gust_b * gauss(rng);
       drift += drift_step * gauss(rng);
       measured = history.front() + drift + cfg.sensor.noise_std_deg * gauss(rng);
       if (!res.activated && s.y >= cfg.scene.normal_area_m) {
@@ -106,7 +114,6 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
       applied = commands.front().second;
       commands.pop_front();
     }
-    gust = gust_a * gust + gust_b * gauss(rng);
     vehicle.step(applied, cfg.speed_m_s, gust);
   }
   res.min_wall_distance_m = cfg.scene.wall_y_m - res.max_y_m;
