@@ -120,14 +120,9 @@ std::vector<double> ate_errors(const Trajectory& ref, const Trajectory& aligned_
 }
 
 double RelativeErrors::translation_percent() const {
-  double sum = 0;
-  int n = 0;
-  for (size_t k = 0; k < translation.size(); ++k) {
-    if (ref_distance[k] < 1e-3) continue;
-    sum += 100.0 * translation[k] / ref_distance[k];
-    ++n;
-  }
-  return n ? sum / n : 0.0;
+  const double err = std::accumulate(translation.begin(), translation.end(), 0.0);
+  const double dist = std::accumulate(ref_distance.begin(), ref_distance.end(), 0.0);
+  return dist > 0 ? 100.0 * err / dist : 0.0;
 }
 
 RelativeErrors rpe_frames(const Trajectory& ref, const Trajectory& est, size_t delta_frames) {

@@ -45,7 +45,8 @@ struct RelativeErrors {
   std::vector<double> translation;   // |t(E)| metres
   std::vector<double> rotation_deg;  // angle(E)
   std::vector<double> ref_distance;  // |t(Q_i^-1 Q_j)| metres (for percentages)
-  // Mean over pairs of 100 |t(E)| / |t(Q_i^-1 Q_j)|, skipping pairs where the reference barely moved.
+  // 100 * sum |t(E)| / sum |t(Q_i^-1 Q_j)|: translational error as a percentage of the distance
+  // travelled (a ratio of sums, so frames where the vehicle stands still do not dominate).
   double translation_percent() const;
 };
 // Pairs (i, i + delta_frames) for every i.

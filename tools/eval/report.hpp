@@ -20,7 +20,7 @@ struct Report {
   Similarity alignment;
   Stats ate;                        // metres
   Stats rpe_trans, rpe_rot;         // per delta_frames: metres, degrees
-  double rpe_trans_percent = 0;     // mean of 100 |t(E)| / |t(Q)|
+  double rpe_trans_percent = 0;     // 100 sum |t(E)| / sum |t(Q)|
   Stats rpe_path_trans;             // over path segments (if rpe_delta_m > 0)
   AxisRmse axes;
   Drift drift;
