@@ -8,99 +8,82 @@ namespace aerie::sim {
 
 namespace {
 
-// Every key of the section must be one we know (a typo would otherwise be ignored).
-void check_keys(const util::Config& section, const std::vector<std::string>& known) {
-  const YAML::Node& n = section.node();
-  if (!n || n.IsNull()) return;
-  if (!n.IsMap()) throw std::runtime_error(section.origin() + ": expected a map of keys");
-  for (const auto& kv : n) {
-    const std::string key = kv.first.as<std::string>();
-    if (std::find(known.begin(), known.end(), key) == known.end()) {
+// Reads the keys of one section into a struct, each key named once; finish() then rejects
+// any key of the section that was not read (a typo would otherwise be silently ignored).
+template <typename S>
+class SectionReader {
+ public:
+  SectionReader(const util::Config& section, S& out) : c_(section), out_(out) {}
+  template <typename T>
+  SectionReader& operator()(const std::string& key, T S::*member) {
+    out_.*member = c_.get<T>(key, out_.*member);
+    known_.push_back(key);
+    return *this;
+  }
+  void finish() const {
+    const YAML::Node& n = c_.node();
+    if (!n || n.IsNull()) return;
+    if (!n.IsMap()) throw std::runtime_error(c_.origin() + ": expected a map of keys");
+    for (const auto& kv : n) {
+      const std::string key = kv.first.as<std::string>();
+      if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
       std::string list;
-      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      throw std::runtime_error(section.origin() + ": unknown key '" + key + "' (known: " + list + ")");
+      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
+      throw std::runtime_error(c_.origin() + ": unknown key '" + key + "' (known: " + list + ")");
     }
   }
-}
 
-template <typename T>
-void read(const util::Config& c, const std::string& key, T& value) {
-  value = c.get<T>(key, value);
-}
+ private:
+  const util::Config& c_;
+  S& out_;
+  std::vector<std::string> known_;
+};
 
 }  // namespace
 
 WorldConfig load_world_config(const util::Config& c) {
-  check_keys(c, {"seed", "room_x", "room_y", "room_z", "n_obstacles", "helipad_size", "helipad_yaw_deg",
-                 "texels_per_metre", "route_margin", "route_clearance", "cruise_altitude"});
   WorldConfig w;
-  read(c, "seed", w.seed);
-  read(c, "room_x", w.room_x);
-  read(c, "room_y", w.room_y);
-  read(c, "room_z", w.room_z);
-  read(c, "n_obstacles", w.n_obstacles);
-  read(c, "helipad_size", w.helipad_size);
-  read(c, "helipad_yaw_deg", w.helipad_yaw_deg);
-  read(c, "texels_per_metre", w.texels_per_metre);
-  read(c, "route_margin", w.route_margin);
-  read(c, "route_clearance", w.route_clearance);
-  read(c, "cruise_altitude", w.cruise_altitude);
+  using W = WorldConfig;
+  SectionReader<W>(c, w)("seed", &W::seed)("room_x", &W::room_x)("room_y", &W::room_y)("room_z", &W::room_z)(
+      "n_obstacles", &W::n_obstacles)("helipad_size", &W::helipad_size)("helipad_yaw_deg", &W::helipad_yaw_deg)(
+      "texels_per_metre", &W::texels_per_metre)("route_margin", &W::route_margin)(
+      "route_clearance", &W::route_clearance)("cruise_altitude", &W::cruise_altitude)
+      .finish();
   return w;
 }
 
 RigConfig load_rig_config(const util::Config& c) {
-  check_keys(c, {"width", "height", "baseline", "hfov_deg", "vfov_deg", "pitch_deg", "color", "noise_sigma",
-                 "exposure", "illumination_amplitude", "illumination_period", "right_gain", "disparity",
-                 "noise_seed", "motion_blur_samples", "exposure_time"});
   RigConfig r;
-  read(c, "width", r.width);
-  read(c, "height", r.height);
-  read(c, "baseline", r.baseline);
-  read(c, "hfov_deg", r.hfov_deg);
-  read(c, "vfov_deg", r.vfov_deg);
-  read(c, "pitch_deg", r.pitch_deg);
-  read(c, "color", r.color);
-  read(c, "noise_sigma", r.noise_sigma);
-  read(c, "exposure", r.exposure);
-  read(c, "illumination_amplitude", r.illumination_amplitude);
-  read(c, "illumination_period", r.illumination_period);
-  read(c, "right_gain", r.right_gain);
-  read(c, "disparity", r.disparity);
-  read(c, "noise_seed", r.noise_seed);
-  read(c, "motion_blur_samples", r.motion_blur_samples);
-  read(c, "exposure_time", r.exposure_time);
+  using R = RigConfig;
+  SectionReader<R>(c, r)("width", &R::width)("height", &R::height)("baseline", &R::baseline)(
+      "hfov_deg", &R::hfov_deg)("vfov_deg", &R::vfov_deg)("pitch_deg", &R::pitch_deg)("color", &R::color)(
+      "noise_sigma", &R::noise_sigma)("noise_seed", &R::noise_seed)("exposure", &R::exposure)(
+      "illumination_amplitude", &R::illumination_amplitude)("illumination_period", &R::illumination_period)(
+      "right_gain", &R::right_gain)("motion_blur_samples", &R::motion_blur_samples)(
+      "exposure_time", &R::exposure_time)("disparity", &R::disparity)
+      .finish();
   return r;
 }
 
 TrajectoryConfig load_trajectory_config(const util::Config& c) {
-  check_keys(c, {"kind", "speed", "loops", "rate_hz", "start_utime"});
   TrajectoryConfig t;
-  read(c, "kind", t.kind);
-  read(c, "speed", t.speed);
-  read(c, "loops", t.loops);
-  read(c, "rate_hz", t.rate_hz);
-  read(c, "start_utime", t.start_utime);
+  using T = TrajectoryConfig;
+  SectionReader<T>(c, t)("kind", &T::kind)("speed", &T::speed)("loops", &T::loops)("rate_hz", &T::rate_hz)(
+      "start_utime", &T::start_utime)
+      .finish();
   if (t.kind != "demo" && t.kind != "loops" && t.kind != "landing")
     throw std::runtime_error(c.origin() + ": key 'kind' must be demo, loops or landing (got '" + t.kind + "')");
   return t;
 }
 
 IntruderConfig load_intruder_config(const util::Config& c) {
-  check_keys(c, {"seed", "width", "height", "frames", "rate_hz", "start_utime", "vibration_px", "wingspan_px",
-                 "scale_change", "max_roll_deg", "noise_sigma", "color"});
   IntruderConfig i;
-  read(c, "seed", i.seed);
-  read(c, "width", i.width);
-  read(c, "height", i.height);
-  read(c, "frames", i.frames);
-  read(c, "rate_hz", i.rate_hz);
-  read(c, "start_utime", i.start_utime);
-  read(c, "vibration_px", i.vibration_px);
-  read(c, "wingspan_px", i.wingspan_px);
-  read(c, "scale_change", i.scale_change);
-  read(c, "max_roll_deg", i.max_roll_deg);
-  read(c, "noise_sigma", i.noise_sigma);
-  read(c, "color", i.color);
+  using I = IntruderConfig;
+  SectionReader<I>(c, i)("seed", &I::seed)("width", &I::width)("height", &I::height)("frames", &I::frames)(
+      "rate_hz", &I::rate_hz)("start_utime", &I::start_utime)("vibration_px", &I::vibration_px)(
+      "wingspan_px", &I::wingspan_px)("scale_change", &I::scale_change)("max_roll_deg", &I::max_roll_deg)(
+      "noise_sigma", &I::noise_sigma)("color", &I::color)
+      .finish();
   return i;
 }
 
