@@ -2,6 +2,7 @@
 // and with the images; determinism; texture quality for feature tracking.
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -178,6 +179,32 @@ TEST(SimRender, RightImageMatchesLeftThroughDisparity) {
   std::sort(nccs.begin(), nccs.end());
   EXPECT_GT(nccs[nccs.size() / 2], 0.97);   // median
   EXPECT_GT(nccs[nccs.size() / 10], 0.85);  // 90 % of the patches
+}
+
+TEST(SimRender, StereoMatchingRecoversTheDisparity) {
+  // The textures must let a standard matcher (OpenCV SGBM) find the true disparity.
+  const World& w = test::default_world();
+  RigConfig rig;
+  rig.disparity = true;
+  rig.noise_sigma = 1.0;
+  StereoSimulation sim(w, rig, Trajectory::demo_flight(w));
+  auto sgbm = cv::StereoSGBM::create(0, 64, 5, 8 * 25, 32 * 25, 1, 0, 10, 100, 2, cv::StereoSGBM::MODE_SGBM);
+  for (int k : {200, 450, 700}) {
+    const StereoFrame f = sim.frame(k);
+    cv::Mat disp16;
+    sgbm->compute(f.left, f.right, disp16);
+    int valid = 0, good = 0;
+    for (int v = 0; v < disp16.rows; ++v)
+      for (int u = 64; u < disp16.cols; ++u) {  // columns with the full search range
+        const short d = disp16.at<short>(v, u);
+        if (d < 0) continue;
+        ++valid;
+        good += std::abs(d / 16.0 - f.disparity.at<float>(v, u)) <= 1.0;
+      }
+    const double area = (disp16.cols - 64.0) * disp16.rows;
+    EXPECT_GT(valid, 0.9 * area) << "frame " << k;
+    EXPECT_GT(good, 0.95 * valid) << "frame " << k;
+  }
 }
 
 TEST(SimRender, HelipadBoxIsTheProjectionOfItsCorners) {
