@@ -90,10 +90,10 @@ void scatter_marks(cv::Mat& img, double density, double per_m2, cv::RNG& rng, do
   for (int i = 0; i < n; ++i) {
     const double size = density * std::exp(rng.uniform(std::log(0.01), std::log(0.12)));
     const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), rng.uniform(0.0, 1.0 * img.rows));
-    const double mean = cv::mean(img(cv::Rect(std::clamp(static_cast<int>(c.x), 0, img.cols - 1),
-                                             std::clamp(static_cast<int>(c.y), 0, img.rows - 1), 1, 1)))[0];
+    const float below = img.at<float>(std::min(static_cast<int>(c.y), img.rows - 1),
+                                      std::min(static_cast<int>(c.x), img.cols - 1));
     // Dark on bright, bright on dark.
-    const double shade = mean > 0.5 ? rng.uniform(0.0, 0.5 - 0.3 * contrast) : rng.uniform(0.5 + 0.3 * contrast, 1.0);
+    const double shade = below > 0.5f ? rng.uniform(0.0, 0.5 - 0.3 * contrast) : rng.uniform(0.5 + 0.3 * contrast, 1.0);
     const cv::Scalar col(shade);
     auto P = [&](double x, double y) { return cv::Point(cvRound(x * sub), cvRound(y * sub)); };
     switch (rng.uniform(0, 5)) {
