@@ -195,19 +195,16 @@ void StereoRenderer::render_view(const geometry::SE3& T_world_cam, cv::Mat& radi
         // Obstacles: the entry face of the nearest one.
         for (const Box* b : row_boxes) {
           if (u < b->u0 || u > b->u1) continue;
-          float t_near = -std::numeric_limits<float>::infinity(), t_far = std::numeric_limits<float>::infinity();
-          int axis = 0;
-          for (int a = 0; a < 3; ++a) {
-            const float t1 = b->lo[a] * inv[a], t2 = b->hi[a] * inv[a];
-            const float tn = min_f(t1, t2), tf = max_f(t1, t2);
-            if (tn > t_near) {
-              t_near = tn;
-              axis = a;
-            }
-            t_far = min_f(t_far, tf);
-          }
+          // Slab test, branch-free; the entry axis is only worked out for a nearer hit.
+          const float ax1 = b->lo[0] * inv[0], ax2 = b->hi[0] * inv[0];
+          const float ay1 = b->lo[1] * inv[1], ay2 = b->hi[1] * inv[1];
+          const float az1 = b->lo[2] * inv[2], az2 = b->hi[2] * inv[2];
+          const float nx = min_f(ax1, ax2), ny = min_f(ay1, ay2), nz = min_f(az1, az2);
+          const float t_near = max_f(nx, max_f(ny, nz));
+          const float t_far = min_f(max_f(ax1, ax2), min_f(max_f(ay1, ay2), max_f(az1, az2)));
           if (t_near <= t_far && t_near > 0.f && t_near < t) {
             t = t_near;
+            const int axis = t_near == nx ? 0 : (t_near == ny ? 1 : 2);
             surface = 6 + 6 * b->index + 2 * axis + (d[axis] > 0.f ? 0 : 1);
           }
         }
@@ -229,13 +226,12 @@ void StereoRenderer::render_view(const geometry::SE3& T_world_cam, cv::Mat& radi
         const float tu = (pu - static_cast<float>(s.u0)) * density - 0.5f;
         const float tv = static_cast<float>(s.v_sign) * (pv - static_cast<float>(s.v0)) * density - 0.5f;
         // Footprint: dP/du = t (du - d du_k / d_k) (plane x_k = const), same for v.
+        // Only the two in-plane axes: the k component is zero by construction.
         const float ku = du[k] * inv[k], kv = dv[k] * inv[k];
-        float fu2 = 0.f, fv2 = 0.f;
-        for (int a = 0; a < 3; ++a) {
-          const float eu = du[a] - d[a] * ku, ev = dv[a] - d[a] * kv;
-          fu2 += eu * eu;
-          fv2 += ev * ev;
-        }
+        const int a1 = s.u_axis, a2 = s.v_axis;
+        const float eu1 = du[a1] - d[a1] * ku, eu2 = du[a2] - d[a2] * ku;
+        const float ev1 = dv[a1] - d[a1] * kv, ev2 = dv[a2] - d[a2] * kv;
+        const float fu2 = eu1 * eu1 + eu2 * eu2, fv2 = ev1 * ev1 + ev2 * ev2;
         const float f2 = max_f(fu2, fv2) * t * t * density * density;
         const float lod = f2 > 1.f ? 0.5f * fast_log2(f2) : 0.f;
         const float value = s.shade * tex.trilinear(tu, tv, lod);
