@@ -40,8 +40,7 @@ char* frame_name(char* buf, size_t n, const char* fmt, int k) {
   return buf;
 }
 
-void info(const sim::SimulationConfig& cfg) {
-  const sim::StereoSimulation s = sim::make_simulation(cfg);
+void info(const sim::SimulationConfig& cfg, const sim::StereoSimulation& s) {
   const auto& w = s.world();
   const auto K = s.intrinsics();
   std::printf("room %.1f x %.1f x %.1f m, seed %llu, %zu obstacles\n", w.config().room_x, w.config().room_y,
@@ -217,7 +216,7 @@ int main(int argc, char** argv) {
       if (!cfg.has("trajectory.kind")) sc.trajectory.kind = "landing";
     }
     sim::StereoSimulation s = sim::make_simulation(sc);
-    if (*info_cmd) info(sc);
+    if (*info_cmd) info(sc, s);
     if (*stereo) export_stereo(s, out, every, max_frames);
     if (*landing) export_landing(s, out, ext);
   } catch (const std::exception& e) {
