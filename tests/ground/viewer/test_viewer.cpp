@@ -9,9 +9,12 @@
 #include <thread>
 
 #include <aerie/control_cmd_t.hpp>
+#include <bot_procman/info2_t.hpp>
 
 #include "common/image/image_message.hpp"
+#include "common/util/time.hpp"
 #include "ground/viewer/renderers/charts.hpp"
+#include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
 #include "ground/viewer/viewer.hpp"
 #include "tests/support/test_support.hpp"
@@ -277,4 +280,59 @@ TEST_F(Fixture, SurvivesMalformedMessagesAndChannelsThatStopAndRestart) {
   int64_t malformed = 0;
   for (const auto& s : bus.subscriptions()) malformed += s->counters().malformed + s->counters().handler_errors;
   EXPECT_GE(malformed, 8);
+}
+
+TEST_F(Fixture, ProcmanPanelShowsDeputyCommandsAndStartsOrStopsTheSelectedOne) {
+  make();
+  bot_procman::info2_t info{};
+  info.utime = util::wall_utime();
+  info.host = "air";
+  info.cpu_load = 0.25f;
+  info.phys_mem_total_bytes = 8LL << 30;
+  info.phys_mem_free_bytes = 4LL << 30;
+  for (auto [name, pid, runid] : {std::tuple{"capture", 4242, 1}, std::tuple{"vo", 0, 0}}) {
+    bot_procman::deputy_cmd2_t c{};
+    c.cmd.command_name = name;
+    c.cmd.exec_str = std::string("aerie-") + name;
+    c.cmd.num_options = 0;
+    c.pid = pid;
+    c.actual_runid = runid;
+    c.sheriff_id = pid ? 1 : 2;
+    c.cpu_usage = 0.5f;
+    c.mem_rss_bytes = 64LL << 20;
+    info.cmds.push_back(c);
+  }
+  info.ncmds = 2;
+  info.num_options = 0;
+  std::vector<bot_procman::orders2_t> orders;
+  bus.subscribe<bot_procman::orders2_t>("PMD_ORDERS2", [&](const bot_procman::orders2_t& o, const bus::ReceiveInfo&) {
+    orders.push_back(o);
+  });
+  bus.publish("PMD_INFO2", info);
+  auto* panel = dynamic_cast<ProcmanPanel*>(viewer->find("processes"));
+  ASSERT_NE(panel, nullptr);
+  ASSERT_TRUE(render_until([&] { return panel->text().find("capture") != std::string::npos; }));
+  const std::string text = panel->text();
+  EXPECT_NE(text.find("host air"), std::string::npos) << text;
+  EXPECT_NE(text.find("capture          running"), std::string::npos) << text;
+  EXPECT_NE(text.find("vo"), std::string::npos) << text;
+
+  // Stop the running command (selected first), then start the stopped one.
+  auto stop = ProcmanPanel::orders_for(info, 1, false, 5, "v");
+  ASSERT_EQ(stop.ncmds, 2);
+  EXPECT_EQ(stop.cmds[0].force_quit, 1);
+  EXPECT_EQ(stop.cmds[1].force_quit, 0);
+  EXPECT_EQ(stop.cmds[1].desired_runid, 0);  // untouched: stays stopped
+  auto start = ProcmanPanel::orders_for(info, 2, true, 5, "v");
+  EXPECT_EQ(start.cmds[0].desired_runid, 1);  // untouched: keeps running
+  EXPECT_EQ(start.cmds[1].desired_runid, 1);  // a new run
+  EXPECT_EQ(start.cmds[1].force_quit, 0);
+
+  viewer->on_key("s");  // the selected command is "capture", running: stop it
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  viewer->stop();
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].host, "air");
+  ASSERT_EQ(orders[0].ncmds, 2);
+  EXPECT_EQ(orders[0].cmds[0].force_quit, 1);
 }
