@@ -75,6 +75,8 @@ int main(int argc, char** argv) {
          "demo or survey");
   option(app, ov, "--sim-speed", [](CaptureConfig& c) -> auto& { return c.source.sim.speed; }, "m/s");
   option(app, ov, "--sim-loops", [](CaptureConfig& c) -> auto& { return c.source.sim.loops; }, "survey loops");
+  option(app, ov, "--sim-start-utime", [](CaptureConfig& c) -> auto& { return c.source.sim.start_utime; },
+         "utime of the first simulated frame (-1: the wall clock at start)");
   option(app, ov, "--sim-noise", [](CaptureConfig& c) -> auto& { return c.source.sim.noise_sigma; },
          "image noise sigma, gray levels");
   CLI11_PARSE(app, argc, argv);

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "air/capture/capture_node.hpp"
+#include "air/capture/sim_source.hpp"
 #include "air/capture/stereo_sequence_source.hpp"
 #include "common/bus/node.hpp"
 #include "common/logio/event_log.hpp"
@@ -50,11 +51,8 @@ Payloads payloads_of(const std::string& log, bool with_status = false) {
   return p;
 }
 
-// The messages the capture library makes of the first `frames` KITTI frames at half size.
-Payloads expected_kitti(int frames) {
-  capture::CaptureConfig cfg;
-  cfg.output.downscale = 2;
-  capture::StereoSequenceSource src(capture::load_kitti(test::shared_data(kKitti).string()), false);
+// The messages the capture library makes of the first `frames` frames of a source.
+Payloads expected_messages(capture::FrameSource& src, const capture::CaptureConfig& cfg, int frames) {
   const capture::OutputFormat fmt(cfg.output, src.size());
   const capture::MessageBuilder builder(cfg, true, fmt.apply(*src.rectified()));
   Payloads p;
@@ -65,9 +63,18 @@ Payloads expected_kitti(int frames) {
     p["CAM_LEFT"].push_back(encode(*m.left));
     p["CAM_RIGHT"].push_back(encode(*m.right));
     p["CAM_STEREO"].push_back(encode(*m.stereo));
-    p["GT_POSE"].push_back(encode(*m.gt_pose));
+    if (m.gt_pose) p["GT_POSE"].push_back(encode(*m.gt_pose));
+    if (m.gt_box) p["GT_TRACK"].push_back(encode(*m.gt_box));
   }
   return p;
+}
+
+// The first `frames` KITTI frames at half size.
+Payloads expected_kitti(int frames) {
+  capture::CaptureConfig cfg;
+  cfg.output.downscale = 2;
+  capture::StereoSequenceSource src(capture::load_kitti(test::shared_data(kKitti).string()), false);
+  return expected_messages(src, cfg, frames);
 }
 
 std::string slurp(const fs::path& p) {
@@ -93,26 +100,21 @@ void stop_logger(Process& logger, const fs::path& out) {
   EXPECT_EQ(*rc, 0) << slurp(out);
 }
 
-TEST(CaptureReplay, UdpMulticastLoggerAndLogplayerInNamespace) {
-  AERIE_REQUIRE_DATA(kKitti);
-  if (const auto why = NetNamespace::unavailable(); !why.empty()) GTEST_SKIP() << why;
-  const auto dir = test::scratch_dir("udp");
+// capture -> UDP multicast -> lcm-logger, then lcm-logplayer -> UDP -> lcm-logger,
+// inside a fresh namespace: the first log holds exactly `expected`, the second the
+// same events again.
+void record_and_replay(const fs::path& dir, const std::vector<std::string>& capture_args, const Payloads& expected) {
   NetNamespace ns("aerie-capture-it-" + std::to_string(getpid()));
-  constexpr int kFrames = 20;
-
-  // 1. capture -> UDP multicast -> lcm-logger
   auto logger = start_logger(ns, dir / "flight.lcm", dir / "logger1.txt");
-  Process capture(ns.exec({bin("aerie-capture"), "--lcm-url", kUrl, "--source", "kitti", "--path",
-                           test::shared_data(kKitti).string(), "--downscale", "2", "--rate", "4", "--stop",
-                           std::to_string(kFrames)}),
-                  dir / "capture.txt");
-  const auto rc = capture.wait(120);
+  std::vector<std::string> argv = {bin("aerie-capture"), "--lcm-url", kUrl};
+  argv.insert(argv.end(), capture_args.begin(), capture_args.end());
+  Process capture(ns.exec(argv), dir / "capture.txt");
+  const auto rc = capture.wait(300);
   ASSERT_TRUE(rc) << "aerie-capture did not finish";
   ASSERT_EQ(*rc, 0) << slurp(dir / "capture.txt");
   stop_logger(*logger, dir / "logger1.txt");
 
   const auto recorded = payloads_of((dir / "flight.lcm").string());
-  const auto expected = expected_kitti(kFrames);
   ASSERT_EQ(recorded.size(), expected.size()) << "channels";
   for (const auto& [channel, payloads] : expected) {
     ASSERT_TRUE(recorded.count(channel)) << channel;
@@ -121,22 +123,47 @@ TEST(CaptureReplay, UdpMulticastLoggerAndLogplayerInNamespace) {
       EXPECT_TRUE(recorded.at(channel)[i] == payloads[i]) << channel << " message " << i << " differs";
   }
 
-  // 2. lcm-logplayer -> UDP multicast -> lcm-logger: the same messages again.
   auto logger2 = start_logger(ns, dir / "replay.lcm", dir / "logger2.txt");
   Process player(ns.exec({"lcm-logplayer", "-s", "4", "--lcm-url=" + kUrl, (dir / "flight.lcm").string()}),
                  dir / "player.txt");
-  const auto prc = player.wait(60);
+  const auto prc = player.wait(120);
   ASSERT_TRUE(prc) << "lcm-logplayer did not finish";
   EXPECT_EQ(*prc, 0) << slurp(dir / "player.txt");
   stop_logger(*logger2, dir / "logger2.txt");
   EXPECT_EQ(payloads_of((dir / "replay.lcm").string(), true), payloads_of((dir / "flight.lcm").string(), true));
+}
 
-  // 3. aerie-log info on the recording: no drops, no damage.
+TEST(CaptureReplay, KittiOverUdpMulticastLoggerAndLogplayerInNamespace) {
+  AERIE_REQUIRE_DATA(kKitti);
+  if (const auto why = NetNamespace::unavailable(); !why.empty()) GTEST_SKIP() << why;
+  const auto dir = test::scratch_dir("udp");
+  constexpr int kFrames = 20;
+  record_and_replay(dir,
+                    {"--source", "kitti", "--path", test::shared_data(kKitti).string(), "--downscale", "2", "--rate",
+                     "4", "--stop", std::to_string(kFrames)},
+                    expected_kitti(kFrames));
+
+  // aerie-log info on the recording: no drops, no damage.
   const auto info = dir / "info.txt";
   const int info_rc = std::system((bin("aerie-log") + " info " + (dir / "flight.lcm").string() + " > " + info.string()).c_str());
   EXPECT_EQ(info_rc, 0);
   EXPECT_NE(slurp(info).find("dropped messages (sequence gaps): 0"), std::string::npos) << slurp(info);
   EXPECT_NE(slurp(info).find("aerie.stereo_image_t"), std::string::npos);
+}
+
+// A simulated flight (fixed start time, so the run is reproducible): the log holds the
+// same payloads as an in-process rerun of the simulator, and its replay gives them again.
+TEST(CaptureReplay, SimulatedFlightRecordedAndReplayedOverUdp) {
+  if (const auto why = NetNamespace::unavailable(); !why.empty()) GTEST_SKIP() << why;
+  const auto dir = test::scratch_dir("sim");
+  constexpr int kFrames = 30;  // 1.5 s of flight at 20 Hz
+  capture::SimSourceOptions sim;
+  sim.start_utime = 1'000'000;
+  capture::SimSource src(sim, 0, 0, false, 20.0);
+  record_and_replay(dir,
+                    {"--source", "sim", "--sim-start-utime", "1000000", "--rate", "2", "--stop",
+                     std::to_string(kFrames)},
+                    expected_messages(src, capture::CaptureConfig{}, kFrames));
 }
 
 // In-process: capture -> memq -> a recorder writing the standard log format -> a
