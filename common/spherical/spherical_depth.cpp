@@ -235,7 +235,10 @@ SphericalDepth SphericalEncoder::encode(Range&& z_of_pixel) const {
       ranges.push_back(r);
     }
   }
-  return reduce(grid_, cfg_, bins, ranges);
+  SphericalDepth out = reduce(grid_, cfg_, bins, ranges);
+  out.focal_px = static_cast<float>(k_.fx);
+  out.baseline_m = static_cast<float>(k_.baseline);
+  return out;
 }
 
 SphericalDepth SphericalEncoder::encode_depth(const cv::Mat& depth) const {

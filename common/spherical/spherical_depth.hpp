@@ -95,6 +95,10 @@ struct SphericalDepth {
   AngularGrid grid;
   float range_scale_m = 0.001f;
   float max_range_m = 0.f;
+  // The stereo camera that produced the depth (0 = unknown), for the map's range error
+  // model sigma_r = r^2 sigma_d / (f b).
+  float focal_px = 0.f;
+  float baseline_m = 0.f;
   std::vector<int32_t> bins;
   std::vector<int16_t> range_q;
 

@@ -30,6 +30,8 @@ aerie::spherical_depth_t to_message(const SphericalDepth& d, int64_t utime, int6
   m.n_azimuth = d.grid.n_azimuth;
   m.range_scale_m = d.range_scale_m;
   m.max_range_m = d.max_range_m;
+  m.focal_px = d.focal_px;
+  m.baseline_m = d.baseline_m;
   // Sparse costs 6 bytes per filled bin, dense 2 bytes per bin of the grid.
   const bool dense = d.size() * 3 > static_cast<size_t>(d.grid.size());
   if (dense) {
@@ -50,6 +52,10 @@ SphericalDepth from_message(const aerie::spherical_depth_t& m) {
   d.grid.validate();
   d.range_scale_m = m.range_scale_m;
   d.max_range_m = m.max_range_m;
+  require(std::isfinite(m.focal_px) && m.focal_px >= 0 && std::isfinite(m.baseline_m) && m.baseline_m >= 0,
+          "focal_px and baseline_m must be finite and >= 0");
+  d.focal_px = m.focal_px;
+  d.baseline_m = m.baseline_m;
   require(m.nbins >= 0 && m.nrange >= 0, "negative nbins/nrange");
   if (m.nbins == 0) {
     require(m.nrange == 0 || m.nrange == d.grid.size(),

@@ -256,6 +256,8 @@ TEST(SphericalMessage, SparseAndDenseRoundTripThroughLcmBytes) {
     EXPECT_EQ(back.grid, d->grid);
     EXPECT_EQ(back.bins, d->bins);
     EXPECT_EQ(back.range_q, d->range_q);
+    EXPECT_FLOAT_EQ(back.focal_px, 260.f);
+    EXPECT_FLOAT_EQ(back.baseline_m, 0.12f);
     EXPECT_EQ(back_msg.utime, 123456);
     const auto p = sp::pose_of(back_msg);
     ASSERT_TRUE(p.has_value());
