@@ -24,6 +24,7 @@
 #include "common/util/time.hpp"
 #include "tools/link/link_config.hpp"
 #include "tools/link/link_model.hpp"
+#include "tools/latency/stats.hpp"
 #include "tools/link/reencode.hpp"
 
 namespace {
@@ -94,15 +95,6 @@ struct Route {
   std::vector<double> delays_ms;  // achieved over the stats period
   int64_t bytes_at_period_start = 0;
 };
-
-// Nearest-rank percentile (reorders v).
-double percentile(std::vector<double>& v, double q) {
-  if (v.empty()) return 0.0;
-  const double rank = std::ceil(q * static_cast<double>(v.size()));
-  const size_t k = rank < 1 ? 0 : std::min(v.size() - 1, static_cast<size_t>(rank) - 1);
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
-}
 
 }  // namespace
 
@@ -245,10 +237,11 @@ int main(int argc, char** argv) {
           d.reencoded = c.reencoded;
           d.queue_depth = r.model.queue_depth();
           d.queue_bytes = r.model.queue_bytes();
-          d.delay_p50_ms = percentile(r.delays_ms, 0.50);
-          d.delay_p90_ms = percentile(r.delays_ms, 0.90);
-          d.delay_p99_ms = percentile(r.delays_ms, 0.99);
-          d.delay_max_ms = r.delays_ms.empty() ? 0.0 : *std::max_element(r.delays_ms.begin(), r.delays_ms.end());
+          const auto delay = latency::summarize(std::move(r.delays_ms));
+          d.delay_p50_ms = delay.median;
+          d.delay_p90_ms = delay.p90;
+          d.delay_p99_ms = delay.p99;
+          d.delay_max_ms = delay.max;
           d.throughput_bps = static_cast<double>(c.bytes_delivered - r.bytes_at_period_start) * 8.0 / cfg.stats_period_s;
           r.bytes_at_period_start = c.bytes_delivered;
           r.delays_ms.clear();

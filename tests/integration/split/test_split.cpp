@@ -119,8 +119,15 @@ class Split : public ::testing::Test {
     const std::string slog = sheriff.log();
     EXPECT_NE(slog.find("air/talker: starting -> running"), std::string::npos) << slog;
     EXPECT_NE(slog.find("script: done"), std::string::npos) << slog;
+    // aerie-latency on the recorded flight: per channel and, from the talker's
+    // heartbeat, per hop.
+    latency_report_ = testbed::run({bin("aerie-latency"), log});
+    EXPECT_NE(latency_report_.find("CAM_LEFT"), std::string::npos) << latency_report_;
+    EXPECT_NE(latency_report_.find("\ntalker "), std::string::npos) << latency_report_;
+    std::cout << latency_report_;
     return read_log(log);
   }
+  std::string latency_report_;
 
   std::unique_ptr<testbed::NetNamespace> air_, ground_;
   std::vector<std::unique_ptr<testbed::Process>> processes_;
