@@ -48,6 +48,7 @@ class Params {
 };
 
 DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
+  in.read("channels", p.channels);
   in.read("max_levels", p.max_levels);
   in.read("min_size", p.min_size);
   in.read("search_radius", p.search_radius);
@@ -65,7 +66,7 @@ DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
   in.read("min_scale", p.min_scale);
   in.read("max_scale", p.max_scale);
   in.read("redetection", p.redetection);
-  in.read("lost_confidence", p.lost_confidence);
+  in.read("confidence_rate", p.confidence_rate);
   in.read("lost_frames", p.lost_frames);
   in.read("found_confidence", p.found_confidence);
   in.read("redetect_stride", p.redetect_stride);

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   std::string data, out = "track-bench", trackers_arg, sequences_arg, config_path, resize_arg;
   uint64_t seed = 1;
   int max_frames = 0;
-  bool no_plots = false;
+  bool no_plots = false, states = false;
   std::string log_level = "info";
   app.add_option("--data", data, "folder of sequences: <SEQ>/img/* and <SEQ>/groundtruth.txt")->required();
   app.add_option("--out", out, "output folder")->capture_default_str();
@@ -73,6 +73,7 @@ int main(int argc, char** argv) {
   app.add_option("--resize", resize_arg, "resize frames and boxes to WxH (e.g. 640x480) before tracking");
   app.add_option("--max-frames", max_frames, "use at most this many frames per sequence (0 = all)");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
+  app.add_flag("--states", states, "also write <out>/<tracker>/<SEQ>.states.csv (confidence, lost, IoU per frame)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("bench-track", log_level);
@@ -112,6 +113,7 @@ int main(int argc, char** argv) {
       std::vector<std::unique_ptr<Tracker>> ts;
       std::vector<Run> seq_runs(trackers.size());
       std::vector<std::vector<cv::Rect2d>> boxes(trackers.size());
+      std::vector<std::vector<TrackState>> track_states(trackers.size());
       for (size_t k = 0; k < trackers.size(); ++k) {
         ts.push_back(make_tracker(trackers[k], config.section(trackers[k]), seed));
         seq_runs[k].tracker = trackers[k];
@@ -149,6 +151,7 @@ int main(int argc, char** argv) {
             r.lost += s.lost;
             r.redetected += s.redetected;
             boxes[k].push_back(s.box());
+            if (states) track_states[k].push_back(s);
           } catch (const std::exception& e) {
             r.error = e.what();
             spdlog::warn("{} on {} frame {}: {}", trackers[k], seq.name, i + 1, e.what());
@@ -160,6 +163,16 @@ int main(int argc, char** argv) {
         Run& r = seq_runs[k];
         r.score = eval::score(boxes[k], gt);
         eval::write_boxes(fs::path(out) / trackers[k] / (seq.name + ".txt"), boxes[k]);
+        if (states && track_states[k].size() + 1 == n) {
+          std::ofstream f(fs::path(out) / trackers[k] / (seq.name + ".states.csv"));
+          f << "frame,x,y,scale,confidence,lost,redetected,samples,iou\n";
+          for (size_t i = 1; i < n; ++i) {
+            const TrackState& t = track_states[k][i - 1];
+            f << i + 1 << ',' << t.pose.x << ',' << t.pose.y << ',' << t.pose.scale << ',' << t.confidence << ','
+              << t.lost << ',' << t.redetected << ',' << t.samples_evaluated() << ',' << eval::iou(boxes[k][i], gt[i])
+              << '\n';
+          }
+        }
         spdlog::info("{:>18} {:<26} AUC {:.3f}  P20 {:.3f}  CLE {:7.1f}  {:8.1f} fps  {:6.0f} samples/frame{}",
                      r.tracker, r.sequence, r.score.auc, r.score.precision20, r.score.mean_centre_error, r.fps(),
                      n > 1 ? r.samples / (n - 1) : 0.0, r.error.empty() ? "" : "  (failed: " + r.error + ")");

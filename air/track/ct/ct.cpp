@@ -4,29 +4,28 @@
 
 namespace aerie::track {
 
-CtClassifier::CtClassifier(cv::Size template_size, const CtParams& params, Rng& rng)
-    : features_(make_compressive_features(template_size, params.features, params.min_rects, params.max_rects, rng),
+CtClassifier::CtClassifier(cv::Size template_size, const CtParams& params, const std::vector<int>& channels, Rng& rng)
+    : features_(make_compressive_features(template_size, params.features, params.min_rects, params.max_rects, channels, rng),
                 template_size),
-      bayes_(params.features, params.learning_rate, params.sigma_min, params.log_floor) {}
+      bayes_(sigma_floors(features_.base(), params.sigma_min), params.learning_rate, params.log_floor) {}
 
-void CtClassifier::score(const IntegralImage& ii, const SampleSet& samples, double scale, std::vector<float>& out) {
-  evaluate_features(ii, features_.at(scale), samples, v_);
+void CtClassifier::score(const ChannelImages& ch, const SampleSet& samples, double scale, std::vector<float>& out) {
+  evaluate_features(ch, features_.at(scale), samples, v_);
   bayes_.classify(v_, out);
 }
 
-void CtClassifier::update(const IntegralImage& ii, const SampleSet& positives, const SampleSet& negatives,
+void CtClassifier::update(const ChannelImages& ch, const SampleSet& positives, const SampleSet& negatives,
                           double scale) {
-  evaluate_features(ii, features_.at(scale), positives, v_pos_);
-  evaluate_features(ii, features_.at(scale), negatives, v_neg_);
+  evaluate_features(ch, features_.at(scale), positives, v_pos_);
+  evaluate_features(ch, features_.at(scale), negatives, v_neg_);
   bayes_.update(v_pos_, v_neg_);
 }
 
-double CtClassifier::confidence(float score) const { return 1.0 / (1.0 + std::exp(-score / terms())); }
 
 ClassifierFactory ct_classifier_factory(const CtParams& params) {
   if (params.features < 1) throw std::invalid_argument("ct: features must be >= 1");
-  return [params](cv::Size template_size, Rng& rng) -> std::unique_ptr<SampleClassifier> {
-    return std::make_unique<CtClassifier>(template_size, params, rng);
+  return [params](cv::Size template_size, const std::vector<int>& channels, Rng& rng) -> std::unique_ptr<SampleClassifier> {
+    return std::make_unique<CtClassifier>(template_size, params, channels, rng);
   };
 }
 

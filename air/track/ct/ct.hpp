@@ -15,18 +15,17 @@ struct CtParams {
   int min_rects = 2;     // non-zero entries per row of R
   int max_rects = 4;
   double learning_rate = 0.85;  // eta of eq. 3.22 (weight of the old model)
-  double sigma_min = 1.0;       // floor of every sigma, grey-level sums
+  double sigma_min = 2.0;       // floor of every sigma, grey levels (x feature_gain)
   double log_floor = std::log(1e-30);  // floor of each class log-density
 };
 
 class CtClassifier : public SampleClassifier {
  public:
-  CtClassifier(cv::Size template_size, const CtParams& params, Rng& rng);
+  CtClassifier(cv::Size template_size, const CtParams& params, const std::vector<int>& channels, Rng& rng);
 
   cv::Size footprint(double scale) const override { return features_.footprint(scale); }
-  void score(const IntegralImage& ii, const SampleSet& samples, double scale, std::vector<float>& out) override;
-  void update(const IntegralImage& ii, const SampleSet& positives, const SampleSet& negatives, double scale) override;
-  double confidence(float score) const override;
+  void score(const ChannelImages& ch, const SampleSet& samples, double scale, std::vector<float>& out) override;
+  void update(const ChannelImages& ch, const SampleSet& positives, const SampleSet& negatives, double scale) override;
   int terms() const override { return static_cast<int>(features_.base().size()); }
 
   const NaiveBayes& bayes() const { return bayes_; }

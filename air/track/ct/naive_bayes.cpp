@@ -15,11 +15,13 @@ Gaussian blend_ct(const Gaussian& old, const Gaussian& sample, double eta) {
   return {static_cast<float>(eta * old.mu + (1 - eta) * sample.mu), static_cast<float>(std::sqrt(var))};
 }
 
-NaiveBayes::NaiveBayes(int n, double eta, double sigma_min, double log_floor)
-    : eta_(eta), sigma_min_(sigma_min), log_floor_(log_floor), pos_(n), neg_(n) {
-  if (n < 1) throw std::invalid_argument("naive Bayes: need at least one feature");
+NaiveBayes::NaiveBayes(std::vector<float> sigma_floor, double eta, double log_floor)
+    : eta_(eta), log_floor_(log_floor), sigma_floor_(std::move(sigma_floor)), pos_(sigma_floor_.size()),
+      neg_(sigma_floor_.size()) {
+  if (sigma_floor_.empty()) throw std::invalid_argument("naive Bayes: need at least one feature");
   if (!(eta >= 0 && eta < 1)) throw std::invalid_argument("naive Bayes: learning rate must be in [0, 1)");
-  if (!(sigma_min > 0)) throw std::invalid_argument("naive Bayes: sigma_min must be > 0");
+  for (float f : sigma_floor_)
+    if (!(f > 0)) throw std::invalid_argument("naive Bayes: sigma floors must be > 0");
 }
 
 void NaiveBayes::update(const cv::Mat& positives, const cv::Mat& negatives) {
@@ -32,7 +34,7 @@ void NaiveBayes::update(const cv::Mat& positives, const cv::Mat& negatives) {
     for (int i = 0; i < n; ++i) {
       const Gaussian g = sample_gaussian(m.ptr<float>(i), m.cols);
       model[i] = trained_ ? blend_ct(model[i], g, eta_) : g;
-      model[i].sigma = std::max(model[i].sigma, static_cast<float>(sigma_min_));
+      model[i].sigma = std::max(model[i].sigma, sigma_floor_[i]);
     }
   };
   apply(pos_, positives);

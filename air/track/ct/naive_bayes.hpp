@@ -15,9 +15,9 @@ Gaussian blend_ct(const Gaussian& old, const Gaussian& sample, double eta);
 
 class NaiveBayes {
  public:
-  // n features; eta in [0, 1); sigma_min floors every sigma (feature units); log_floor floors
+  // One entry of sigma_floor per feature (feature units); eta in [0, 1); log_floor floors
   // each class log-density (the reference implementation's log(p + 1e-30)).
-  NaiveBayes(int n, double eta, double sigma_min, double log_floor);
+  NaiveBayes(std::vector<float> sigma_floor, double eta, double log_floor);
 
   // Rows = features, columns = samples. The first update sets the parameters from the
   // samples (there is nothing to blend with yet); later ones apply eq. 3.22.
@@ -30,7 +30,8 @@ class NaiveBayes {
   const std::vector<Gaussian>& negative() const { return neg_; }
 
  private:
-  double eta_, sigma_min_, log_floor_;
+  double eta_, log_floor_;
+  std::vector<float> sigma_floor_;
   bool trained_ = false;
   std::vector<Gaussian> pos_, neg_;
 };

@@ -32,10 +32,13 @@ WeightedRect random_rect(cv::Size box, Rng& rng) {
 
 }  // namespace
 
-std::vector<RectFeature> make_compressive_features(cv::Size box, int n, int min_rects, int max_rects, Rng& rng) {
+std::vector<RectFeature> make_compressive_features(cv::Size box, int n, int min_rects, int max_rects,
+                                                   const std::vector<int>& channels, Rng& rng) {
   check_box(box, min_rects, max_rects, "compressive features");
+  if (channels.empty()) throw std::invalid_argument("compressive features: no channels");
   std::vector<RectFeature> out(n);
   for (auto& f : out) {
+    f.channel = channels[uniform_int(rng, 0, static_cast<int>(channels.size()) - 1)];
     f.count = uniform_int(rng, min_rects, max_rects);
     for (int r = 0; r < f.count; ++r) {
       f.rects[r] = random_rect(box, rng);
@@ -45,10 +48,13 @@ std::vector<RectFeature> make_compressive_features(cv::Size box, int n, int min_
   return out;
 }
 
-std::vector<RectFeature> make_haar_features(cv::Size box, int n, int min_rects, int max_rects, Rng& rng) {
+std::vector<RectFeature> make_haar_features(cv::Size box, int n, int min_rects, int max_rects,
+                                            const std::vector<int>& channels, Rng& rng) {
   check_box(box, min_rects, max_rects, "Haar features");
+  if (channels.empty()) throw std::invalid_argument("Haar features: no channels");
   std::vector<RectFeature> out(n);
   for (auto& f : out) {
+    f.channel = channels[uniform_int(rng, 0, static_cast<int>(channels.size()) - 1)];
     f.count = uniform_int(rng, min_rects, max_rects);
     for (int r = 0; r < f.count; ++r) {
       f.rects[r] = random_rect(box, rng);
@@ -74,6 +80,18 @@ std::vector<RectFeature> scale_features(const std::vector<RectFeature>& features
   return out;
 }
 
+double feature_gain(const RectFeature& f) {
+  double g = 0;
+  for (int r = 0; r < f.count; ++r) g += std::abs(f.rects[r].weight) * f.rects[r].w * f.rects[r].h;
+  return g;
+}
+
+std::vector<float> sigma_floors(const std::vector<RectFeature>& features, double grey_levels) {
+  std::vector<float> out;
+  for (const auto& f : features) out.push_back(static_cast<float>(grey_levels * feature_gain(f)));
+  return out;
+}
+
 cv::Size features_extent(const std::vector<RectFeature>& features) {
   cv::Size e(0, 0);
   for (const auto& f : features)
@@ -84,7 +102,7 @@ cv::Size features_extent(const std::vector<RectFeature>& features) {
   return e;
 }
 
-void evaluate_features(const IntegralImage& ii, const std::vector<RectFeature>& features, const std::vector<int>& which,
+void evaluate_features(const ChannelImages& ch, const std::vector<RectFeature>& features, const std::vector<int>& which,
                        const SampleSet& samples, cv::Mat& out) {
   out.create(static_cast<int>(which.size()), static_cast<int>(samples.size()), CV_32F);
   cv::Size extent(0, 0);
@@ -93,7 +111,7 @@ void evaluate_features(const IntegralImage& ii, const std::vector<RectFeature>& 
       extent.width = std::max(extent.width, features[k].rects[r].x + features[k].rects[r].w);
       extent.height = std::max(extent.height, features[k].rects[r].y + features[k].rects[r].h);
     }
-  const cv::Rect roi = ii.roi();
+  const cv::Rect roi = ch.roi();
   int first = 0;
   for (const SampleRun& run : samples.runs()) {
     // The kernels read the integral image without bounds checks: every footprint must fit.
@@ -101,16 +119,17 @@ void evaluate_features(const IntegralImage& ii, const std::vector<RectFeature>& 
         run.y + extent.height > roi.y + roi.height)
       throw std::logic_error("evaluate_features: samples reach outside the integral image");
     for (size_t k = 0; k < which.size(); ++k)
-      kernels::feature_run(ii, features[which[k]], run.x, run.y, run.count, out.ptr<float>(static_cast<int>(k)) + first);
+      kernels::feature_run(ch[features[which[k]].channel], features[which[k]], run.x, run.y, run.count,
+                           out.ptr<float>(static_cast<int>(k)) + first);
     first += run.count;
   }
 }
 
-void evaluate_features(const IntegralImage& ii, const std::vector<RectFeature>& features, const SampleSet& samples,
+void evaluate_features(const ChannelImages& ch, const std::vector<RectFeature>& features, const SampleSet& samples,
                        cv::Mat& out) {
   std::vector<int> all(features.size());
   for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  evaluate_features(ii, features, all, samples, out);
+  evaluate_features(ch, features, all, samples, out);
 }
 
 ScaledFeatures::ScaledFeatures(std::vector<RectFeature> base, cv::Size box) : base_(std::move(base)), box_(box) {}

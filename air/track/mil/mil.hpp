@@ -16,18 +16,17 @@ struct MilParams {
   int min_rects = 2;     // rectangles per Haar-like feature
   int max_rects = 4;
   double learning_rate = 0.85;  // eta of eq. 3.30 (weight of the old model)
-  double sigma_min = 1.0;       // floor of every sigma, grey levels
+  double sigma_min = 2.0;       // floor of every sigma, grey levels (x feature_gain)
   double log_floor = std::log(1e-30);
 };
 
 class MilClassifier : public SampleClassifier {
  public:
-  MilClassifier(cv::Size template_size, const MilParams& params, Rng& rng);
+  MilClassifier(cv::Size template_size, const MilParams& params, const std::vector<int>& channels, Rng& rng);
 
   cv::Size footprint(double scale) const override { return features_.footprint(scale); }
-  void score(const IntegralImage& ii, const SampleSet& samples, double scale, std::vector<float>& out) override;
-  void update(const IntegralImage& ii, const SampleSet& positives, const SampleSet& negatives, double scale) override;
-  double confidence(float score) const override;
+  void score(const ChannelImages& ch, const SampleSet& samples, double scale, std::vector<float>& out) override;
+  void update(const ChannelImages& ch, const SampleSet& positives, const SampleSet& negatives, double scale) override;
   int terms() const override { return static_cast<int>(boost_.selected().size()); }
 
   const MilBoost& boost() const { return boost_; }

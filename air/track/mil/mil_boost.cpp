@@ -29,13 +29,16 @@ double bag_log_likelihood(double softplus_pos, double softplus_neg) {
   return std::log(-std::expm1(-std::max(softplus_pos, 1e-30))) - softplus_neg;
 }
 
-MilBoost::MilBoost(int pool, int selected, double eta, double sigma_min, double log_floor)
-    : pool_(pool), k_(selected), eta_(eta), sigma_min_(sigma_min), log_floor_(log_floor), pos_(pool), neg_(pool) {
+MilBoost::MilBoost(std::vector<float> sigma_floor, int selected, double eta, double log_floor)
+    : pool_(static_cast<int>(sigma_floor.size())), k_(selected), eta_(eta), log_floor_(log_floor),
+      sigma_floor_(std::move(sigma_floor)), pos_(pool_), neg_(pool_) {
+  const int pool = pool_;
   if (pool < 1 || selected < 1 || selected > pool)
     throw std::invalid_argument("MILBoost: need 1 <= selected (" + std::to_string(selected) + ") <= pool (" +
                                 std::to_string(pool) + ")");
   if (!(eta >= 0 && eta < 1)) throw std::invalid_argument("MILBoost: learning rate must be in [0, 1)");
-  if (!(sigma_min > 0)) throw std::invalid_argument("MILBoost: sigma_min must be > 0");
+  for (float f : sigma_floor_)
+    if (!(f > 0)) throw std::invalid_argument("MILBoost: sigma floors must be > 0");
 }
 
 float MilBoost::weak(int m, float f) const {
@@ -53,7 +56,7 @@ void MilBoost::update(const cv::Mat& positives, const cv::Mat& negatives) {
   auto apply = [&](std::vector<Gaussian>& model, const cv::Mat& m) {
     for (int i = 0; i < pool_; ++i) {
       model[i] = first ? sample_gaussian(m.ptr<float>(i), m.cols) : blend_mil(model[i], m.ptr<float>(i), m.cols, eta_);
-      model[i].sigma = std::max(model[i].sigma, static_cast<float>(sigma_min_));
+      model[i].sigma = std::max(model[i].sigma, sigma_floor_[i]);
     }
   };
   apply(pos_, positives);

@@ -21,8 +21,9 @@ double bag_log_likelihood(double softplus_pos, double softplus_neg);
 
 class MilBoost {
  public:
-  // M weak classifiers, K of them selected; eta the learning rate of eq. 3.30.
-  MilBoost(int pool, int selected, double eta, double sigma_min, double log_floor);
+  // M = sigma_floor.size() weak classifiers (one sigma floor each, feature units), K of them
+  // selected; eta the learning rate of eq. 3.30.
+  MilBoost(std::vector<float> sigma_floor, int selected, double eta, double log_floor);
 
   // Rows = the M pool features, columns = instances of the positive bag / the negatives.
   // Updates every weak classifier (Algorithm 2, line 1; the first update initialises) and
@@ -43,7 +44,8 @@ class MilBoost {
   void select(const cv::Mat& positives, const cv::Mat& negatives);
 
   int pool_, k_;
-  double eta_, sigma_min_, log_floor_;
+  double eta_, log_floor_;
+  std::vector<float> sigma_floor_;
   std::vector<Gaussian> pos_, neg_;
   std::vector<int> selected_;
   // Scratch: weak outputs of the pool per instance (rows padded to a multiple of 16) and H.

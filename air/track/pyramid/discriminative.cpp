@@ -18,11 +18,29 @@ cv::Point top_left(const cv::Point2d& centre, const cv::Size2d& box) {
 
 cv::Point2d centre_of(const cv::Point& tl, const cv::Size2d& box) { return {tl.x + box.width / 2, tl.y + box.height / 2}; }
 
+// True when the box region of a BGR frame has colour (not grey stored as three channels).
+bool has_colour(const cv::Mat& frame, const cv::Rect2d& box) {
+  if (frame.channels() != 3) return false;
+  const cv::Mat roi = frame(cv::Rect(box) & cv::Rect(0, 0, frame.cols, frame.rows));
+  cv::Mat planes[3], d1, d2;
+  cv::split(roi, planes);
+  cv::absdiff(planes[0], planes[1], d1);
+  cv::absdiff(planes[1], planes[2], d2);
+  return cv::mean(d1)[0] + cv::mean(d2)[0] > 2.0;
+}
+
 // Keeps a top-left position where a footprint-sized box fits inside bounds (when it can).
 cv::Point clamp_into(cv::Point tl, cv::Size footprint, const cv::Rect& bounds) {
   tl.x = std::clamp(tl.x, bounds.x, std::max(bounds.x, bounds.x + bounds.width - footprint.width));
   tl.y = std::clamp(tl.y, bounds.y, std::max(bounds.y, bounds.y + bounds.height - footprint.height));
   return tl;
+}
+
+// (best - median) / terms: how far the best sample stands out of the searched region.
+double prominence(std::vector<float> scores, int terms) {
+  const float best = *std::max_element(scores.begin(), scores.end());
+  std::nth_element(scores.begin(), scores.begin() + scores.size() / 2, scores.end());
+  return (best - scores[scores.size() / 2]) / std::max(1, terms);
 }
 
 }  // namespace
@@ -49,6 +67,9 @@ DiscriminativeTracker::DiscriminativeTracker(std::string name, DiscriminativePar
   require(p.scale_step > 1 && p.max_scale_change > 1, "scale_step and max_scale_change must be > 1");
   require(p.min_scale > 0 && p.max_scale > p.min_scale, "need 0 < min_scale < max_scale");
   require(p.lost_frames >= 1 && p.redetect_stride >= 1, "lost_frames and redetect_stride must be >= 1");
+  require(p.update_confidence >= 0 && p.update_confidence <= 1 && p.found_confidence >= 0 && p.found_confidence <= 1,
+          "update_confidence and found_confidence must be in [0, 1]");
+  require(p.confidence_rate > 0 && p.confidence_rate <= 1, "confidence_rate must be in (0, 1]");
   if (!factory_) throw std::invalid_argument(name_ + ": no classifier factory");
 }
 
@@ -66,8 +87,15 @@ void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   scale_ = 1;
   lost_ = false;
   low_frames_ = 0;
+  mean_prominence_ = 0;
+  scored_frames_ = 0;
   rng_.seed(seed_);
 
+  channels_ = parse_channels(params_.channels);
+  if (frame.channels() == 1 || !has_colour(frame, box))  // no colour features for grey content
+    channels_.erase(std::remove_if(channels_.begin(), channels_.end(), [](int c) { return c >= kChromaCr; }),
+                    channels_.end());
+  if (channels_.empty()) channels_ = {kGray};
   // eq. 3.23, capped; every level's template must stay at least 4x4 pixels.
   int n = std::min(params_.max_levels, pyramid::num_levels(box.width, box.height, params_.min_size));
   while (n > 1 && std::min(box.width, box.height) / (1 << (n - 1)) < 4) --n;
@@ -77,28 +105,38 @@ void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
     const double f = 1.0 / (1 << p);
     levels_[p].template_size = {std::max(4, static_cast<int>(std::lround(box.width * f))),
                                 std::max(4, static_cast<int>(std::lround(box.height * f)))};
-    levels_[p].classifier = factory_(levels_[p].template_size, rng_);
+    levels_[p].classifier = factory_(levels_[p].template_size, channels_, rng_);
   }
-  build_pyramid(gray, {0, 0, gray.cols, gray.rows});
+  build_pyramid(frame, gray, {0, 0, gray.cols, gray.rows});
   learn();
   previous_gray_ = gray.clone();
 }
 
-void DiscriminativeTracker::build_pyramid(const cv::Mat& gray, const cv::Rect& roi) {
+void DiscriminativeTracker::build_pyramid(const cv::Mat& frame, const cv::Mat& gray, const cv::Rect& roi) {
   // Align the crop to the coarsest level's grid so that level p sees exactly crop / 2^p.
   const int a = 1 << (levels() - 1);
   cv::Rect r = roi & cv::Rect(0, 0, gray.cols, gray.rows);
   const int x0 = r.x / a * a, y0 = r.y / a * a;
   r = cv::Rect(x0, y0, r.x + r.width - x0, r.y + r.height - y0);
-  cv::Mat img = gray(r);
+  const bool colour = std::any_of(channels_.begin(), channels_.end(), [](int c) { return c >= kChromaCr; });
+  cv::Mat img = gray(r), chroma;
+  if (colour) {
+    cv::Mat ycrcb;
+    cv::cvtColor(frame(r), ycrcb, cv::COLOR_BGR2YCrCb);
+    cv::mixChannels(ycrcb, chroma = cv::Mat(r.size(), CV_8UC2), std::vector<int>{1, 0, 2, 1});
+  }
+  auto halve = [](const cv::Mat& m) {
+    cv::Mat half;
+    const cv::Mat even = m(cv::Rect(0, 0, m.cols & ~1, m.rows & ~1));
+    cv::resize(even, half, cv::Size(even.cols / 2, even.rows / 2), 0, 0, cv::INTER_AREA);  // 2x2 mean
+    return half;
+  };
   for (int p = 0; p < levels(); ++p) {
     if (p > 0) {
-      cv::Mat half;
-      const cv::Mat even = img(cv::Rect(0, 0, img.cols & ~1, img.rows & ~1));
-      cv::resize(even, half, cv::Size(even.cols / 2, even.rows / 2), 0, 0, cv::INTER_AREA);  // 2x2 mean
-      img = half;
+      img = halve(img);
+      if (colour) chroma = halve(chroma);
     }
-    levels_[p].ii = IntegralImage(img, cv::Point(x0 >> p, y0 >> p));
+    levels_[p].ch.compute(img, chroma, channels_, cv::Point(x0 >> p, y0 >> p));
   }
 }
 
@@ -112,13 +150,14 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
     Level& L = levels_[p];
     const cv::Size2d box = cv::Size2d(L.template_size) * scale_;
     const cv::Size fp = L.classifier->footprint(scale_);
-    const cv::Rect bounds = L.ii.roi();
+    const cv::Rect bounds = L.ch.roi();
     if (scan && p == top) {  // re-detection: a grid over the whole level, then refine below
-      const int stride = std::max(1, params_.redetect_stride >> top);
+      const int stride = std::max(1, params_.redetect_stride >> top);  // full-resolution pixels -> level
       const SampleSet grid = grid_samples(fp, bounds, stride);
       if (!grid.empty()) {
-        L.classifier->score(L.ii, grid, scale_, scores);
+        L.classifier->score(L.ch, grid, scale_, scores);
         const size_t b = std::max_element(scores.begin(), scores.end()) - scores.begin();
+        out.prominence = prominence(scores, L.classifier->terms());
         c = centre_of(grid.positions()[b], box);
         radius = stride + 0.5;
         LevelStats scan_stats;
@@ -131,7 +170,7 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
     const SampleSet samples = disc_samples(clamp_into(top_left(c, box), fp, bounds), radius, fp, bounds);
     if (samples.empty())
       throw std::runtime_error(name_ + ": the target box no longer fits into the image at level " + std::to_string(p));
-    L.classifier->score(L.ii, samples, scale_, scores);
+    L.classifier->score(L.ch, samples, scale_, scores);
     const size_t n = scores.size();
     const size_t best = std::max_element(scores.begin(), scores.end()) - scores.begin();
     const cv::Point l = samples.positions()[best];
@@ -145,6 +184,7 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
     st.scores = scores;
 
     c = centre_of(l, box);
+    if (p == top && !scan) out.prominence = prominence(scores, L.classifier->terms());
     if (p > 0) {
       // eq. 3.25: reject the xi^p N_S lowest-scoring samples; the best rejected one is the
       // critical sample and its distance to l^p the critical distance CD^p.
@@ -184,9 +224,9 @@ double DiscriminativeTracker::adapt_scale(const cv::Point2d& centre, const std::
     if (s < params_.min_scale || s > params_.max_scale) continue;
     const cv::Size2d box = cv::Size2d(L.template_size) * s;
     const cv::Size fp = L.classifier->footprint(s);
-    const SampleSet samples = disc_samples(top_left(centre, box), 1.5, fp, L.ii.roi());
+    const SampleSet samples = disc_samples(top_left(centre, box), 1.5, fp, L.ch.roi());
     if (samples.empty()) continue;
-    L.classifier->score(L.ii, samples, s, scores);
+    L.classifier->score(L.ch, samples, s, scores);
     const size_t b = std::max_element(scores.begin(), scores.end()) - scores.begin();
     if (scores[b] > best_score) {
       best_score = scores[b];
@@ -210,10 +250,10 @@ void DiscriminativeTracker::learn() {
     const cv::Size2d box = cv::Size2d(L.template_size) * scale_;
     const cv::Size fp = L.classifier->footprint(scale_);
     const cv::Point tl = top_left(centre_ * f, box);
-    const SampleSet pos = disc_samples(tl, beta, fp, L.ii.roi());
-    const SampleSet neg = ring_samples(tl, gamma, delta, params_.neg_count, fp, L.ii.roi(), rng_);
+    const SampleSet pos = disc_samples(tl, beta, fp, L.ch.roi());
+    const SampleSet neg = ring_samples(tl, gamma, delta, params_.neg_count, fp, L.ch.roi(), rng_);
     if (pos.empty() || neg.empty()) continue;  // target (partly) outside the image: keep the model
-    L.classifier->update(L.ii, pos, neg, scale_);
+    L.classifier->update(L.ch, pos, neg, scale_);
   }
 }
 
@@ -252,34 +292,41 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
     const double reach = std::max(params_.search_radius, top > 0 ? params_.max_radius * (1 << (top - 1)) : 0.0) +
                          params_.neg_outer + (2 << top) + 2;
     const cv::Size2d half = init_size_ * (scale_ * params_.scale_step / 2);
-    build_pyramid(gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
+    build_pyramid(frame, gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
                                            static_cast<int>(centre_.y - half.height - reach)),
                                  cv::Point(static_cast<int>(std::ceil(centre_.x + half.width + reach)),
                                            static_cast<int>(std::ceil(centre_.y + half.height + reach)))));
   } else {
-    build_pyramid(gray, {0, 0, gray.cols, gray.rows});
+    build_pyramid(frame, gray, {0, 0, gray.cols, gray.rows});
   }
   Search s = search(lost_);
   state.levels = std::move(s.levels);
   double score = s.score;
+  (void)score;
   const cv::Point2d previous = centre_;
   const double previous_scale = scale_;
   centre_ = s.centre;
   if (scales.size() > 1 && !lost_) score = adapt_scale(s.centre, scales);
-  const double conf = levels_[0].classifier->confidence(static_cast<float>(score));
+  // Confidence: the prominence of the best sample relative to its running mean while tracking well.
+  const double z = s.prominence;
+  const double conf = scored_frames_ == 0 ? 1.0 : std::clamp(z / std::max(mean_prominence_, 1e-6), 0.0, 1.0);
+  auto confident_frame = [&] {
+    const double rate = std::max(params_.confidence_rate, 1.0 / ++scored_frames_);
+    mean_prominence_ += rate * (z - mean_prominence_);
+    learn();
+  };
 
   if (!lost_) {
-    low_frames_ = conf < params_.lost_confidence ? low_frames_ + 1 : 0;
-    if (params_.redetection && low_frames_ >= params_.lost_frames) {
+    low_frames_ = conf < params_.update_confidence ? low_frames_ + 1 : 0;
+    if (low_frames_ == 0)
+      confident_frame();
+    else if (params_.redetection && low_frames_ >= params_.lost_frames)
       lost_ = true;
-    } else if (conf >= params_.update_confidence) {
-      learn();
-    }
   } else if (conf >= params_.found_confidence) {
     lost_ = false;
     low_frames_ = 0;
     state.redetected = true;
-    learn();
+    confident_frame();
   } else {
     centre_ = previous;  // still lost: report where the target was last seen
     scale_ = previous_scale;

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "air/track/features/integral.hpp"
+#include "air/track/features/channels.hpp"
 #include "air/track/features/random.hpp"
 #include "air/track/features/samples.hpp"
 #include "air/track/tracker.hpp"
@@ -35,26 +35,29 @@ class SampleClassifier {
   // Box that every sample's features stay inside, at the given scale of the template.
   virtual cv::Size footprint(double scale) const = 0;
   // Classifier score of every sample (higher = more target-like), features scaled by `scale`.
-  virtual void score(const IntegralImage& ii, const SampleSet& samples, double scale, std::vector<float>& out) = 0;
+  virtual void score(const ChannelImages& ch, const SampleSet& samples, double scale, std::vector<float>& out) = 0;
   // Online update with positive and negative samples (the first call initialises).
-  virtual void update(const IntegralImage& ii, const SampleSet& positives, const SampleSet& negatives,
+  virtual void update(const ChannelImages& ch, const SampleSet& positives, const SampleSet& negatives,
                       double scale) = 0;
-  // Score -> confidence in [0, 1] (monotonic).
-  virtual double confidence(float score) const = 0;
-  // Number of weak terms summed into a score (features of CT, selected weak classifiers of MIL).
+  // Number of weak terms summed into a score (features of CT, selected weak classifiers of MIL);
+  // score / terms is the mean log-likelihood ratio per term, comparable between classifiers.
   virtual int terms() const = 0;
 };
 
-// Makes the classifier of one level for a template of the given size (pixels of that level).
-using ClassifierFactory = std::function<std::unique_ptr<SampleClassifier>(cv::Size template_size, Rng& rng)>;
+// Makes the classifier of one level for a template of the given size (pixels of that level)
+// whose features may use the given channels.
+using ClassifierFactory =
+    std::function<std::unique_ptr<SampleClassifier>(cv::Size template_size, const std::vector<int>& channels, Rng& rng)>;
 
 struct DiscriminativeParams {
+  // Feature channels: gray, gradient, color (colour is used only for colour frames).
+  std::vector<std::string> channels = {"gray", "gradient"};
   // Pyramid (eq. 3.23): N_PL = min(max_levels, floor(log2(min(T_W, T_H) / min_size))), at least 1.
   int max_levels = 1;
   double min_size = 8;
   // Algorithm 1 radii, in full-resolution pixels; level p uses them divided by 2^p.
   double search_radius = 20;  // alpha: test samples strictly inside it (Table 3.1)
-  double pos_radius = 4;      // beta: positives strictly inside it
+  double pos_radius = 2.5;    // beta: positives strictly inside it
   double neg_inner = 8;       // gamma
   double neg_outer = 30;      // delta
   int neg_count = 50;         // negatives drawn from the ring
@@ -65,18 +68,19 @@ struct DiscriminativeParams {
   double max_radius = 12;
   // Scale adaptation: "none", "classifier" (the final location re-scored at s / rho and
   // s * rho, the best scale wins) or "flow" (Median Flow scale change of points in the box).
-  std::string scale_estimation = "classifier";
+  std::string scale_estimation = "flow";
   double scale_step = 1.05;      // rho
   double max_scale_change = 1.1; // per frame, flow
   double min_scale = 0.2, max_scale = 5;
-  // Loss and re-detection.
+  // Occlusion, loss and re-detection. The confidence of a frame is the prominence of its best
+  // sample over the coarsest level's search (best minus median score, per term) relative to the
+  // running mean of that prominence over the frames tracked with confidence.
+  double update_confidence = 0.5;  // below it the classifiers are not updated (occlusion, clutter)
+  double confidence_rate = 0.05;   // weight of a new frame in the running mean
   bool redetection = true;
-  double lost_confidence = 0.2;   // below it for lost_frames frames -> lost
-  int lost_frames = 3;
-  double found_confidence = 0.5;  // a re-detection scan result above it -> re-detected
-  int redetect_stride = 2;        // grid step of the scan at the coarsest level, pixels of that level
-  // Classifier updates: learning happens only when the confidence is at least this.
-  double update_confidence = 0.0;
+  int lost_frames = 3;             // frames in a row below update_confidence -> lost
+  double found_confidence = 0.7;   // a re-detection scan result at least this -> re-detected
+  int redetect_stride = 8;         // grid step of the scan, full-resolution pixels
 };
 
 class DiscriminativeTracker : public Tracker {
@@ -94,7 +98,8 @@ class DiscriminativeTracker : public Tracker {
   // returns the best sample centre at level 0 (full-resolution pixels) and fills stats.
   struct Search {
     cv::Point2d centre;
-    float score = 0;
+    float score = 0;        // best score at level 0
+    double prominence = 0;  // (best - median) score per term over the coarsest level's search
     std::vector<LevelStats> levels;  // coarsest first
   };
 
@@ -102,10 +107,10 @@ class DiscriminativeTracker : public Tracker {
   struct Level {
     std::unique_ptr<SampleClassifier> classifier;
     cv::Size template_size;  // target box at scale 1, pixels of this level
-    IntegralImage ii;
+    ChannelImages ch;
   };
 
-  void build_pyramid(const cv::Mat& gray, const cv::Rect& roi0);
+  void build_pyramid(const cv::Mat& frame, const cv::Mat& gray, const cv::Rect& roi0);
   cv::Size box_at(int p, double scale) const;
   Search search(bool scan);
   double adapt_scale(const cv::Point2d& centre, const std::vector<double>& candidates);
@@ -117,12 +122,15 @@ class DiscriminativeTracker : public Tracker {
   Rng rng_;
   uint64_t seed_;
   std::vector<Level> levels_;
+  std::vector<int> channels_;
   cv::Size frame_size_;
   cv::Size2d init_size_;
   cv::Point2d centre_;  // target centre, full-resolution pixels
   double scale_ = 1;
   bool lost_ = false;
   int low_frames_ = 0;
+  double mean_prominence_ = 0;  // running mean of Search::prominence on confident frames
+  int scored_frames_ = 0;
   cv::Mat previous_gray_;
 };
 
