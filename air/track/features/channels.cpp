@@ -22,35 +22,37 @@ std::vector<int> parse_channels(const std::vector<std::string>& names) {
   return out;
 }
 
-cv::Mat gradient_magnitude(const cv::Mat& gray) {
-  cv::Mat out(gray.size(), CV_8UC1, cv::Scalar(0));
-  if (gray.cols < 3 || gray.rows < 3) return out;
+void gradient_magnitude(const cv::Mat& gray, cv::Mat& out) {
+  out.create(gray.size(), CV_8UC1);
+  out.setTo(0);
+  if (gray.cols < 3 || gray.rows < 3) return;
   const int w = gray.cols - 2, h = gray.rows - 2;
   cv::Mat gx, gy;
   cv::absdiff(gray(cv::Rect(2, 1, w, h)), gray(cv::Rect(0, 1, w, h)), gx);
   cv::absdiff(gray(cv::Rect(1, 2, w, h)), gray(cv::Rect(1, 0, w, h)), gy);
   cv::Mat inner = out(cv::Rect(1, 1, w, h));
   cv::addWeighted(gx, 0.5, gy, 0.5, 0, inner);
-  return out;
 }
 
 void ChannelImages::compute(const cv::Mat& gray, const cv::Mat& chroma, const std::vector<int>& wanted,
                             cv::Point origin) {
   roi_ = cv::Rect(origin, gray.size());
-  cv::Mat cr[2];
+  bool split = false;
   for (int c : wanted) {
     switch (c) {
       case kGray:
-        ii_[c] = IntegralImage(gray, origin);
+        ii_[c].compute(gray, origin);
         break;
       case kGradient:
-        ii_[c] = IntegralImage(gradient_magnitude(gray), origin);
+        gradient_magnitude(gray, gradient_);
+        ii_[c].compute(gradient_, origin);
         break;
       case kChromaCr:
       case kChromaCb:
         if (chroma.empty()) throw std::invalid_argument("colour feature channels need a colour frame");
-        if (cr[0].empty()) cv::split(chroma, cr);
-        ii_[c] = IntegralImage(cr[c - kChromaCr], origin);
+        if (!split) cv::split(chroma, chroma_);
+        split = true;
+        ii_[c].compute(chroma_[c - kChromaCr], origin);
         break;
       default:
         throw std::invalid_argument("bad channel id");

@@ -28,9 +28,15 @@ class ChannelImages {
  private:
   std::array<IntegralImage, kNumChannels> ii_;
   cv::Rect roi_;
+  cv::Mat gradient_, chroma_[2];  // reused buffers
 };
 
 // Gradient magnitude (|dI/dx| + |dI/dy|) / 2 with central differences, 8-bit, same size.
-cv::Mat gradient_magnitude(const cv::Mat& gray);
+void gradient_magnitude(const cv::Mat& gray, cv::Mat& out);
+inline cv::Mat gradient_magnitude(const cv::Mat& gray) {
+  cv::Mat out;
+  gradient_magnitude(gray, out);
+  return out;
+}
 
 }  // namespace aerie::track

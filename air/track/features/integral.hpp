@@ -9,9 +9,15 @@ namespace aerie::track {
 
 class IntegralImage {
  public:
+  // Columns readable past the right end of every row (vector loads that run over the end of
+  // a row of samples stay inside the allocation).
+  static constexpr int kPadColumns = 16;
+
   IntegralImage() = default;
   // gray: 8-bit single channel covering `origin` .. origin + gray.size() of the level image.
-  IntegralImage(const cv::Mat& gray, cv::Point origin);
+  IntegralImage(const cv::Mat& gray, cv::Point origin) { compute(gray, origin); }
+  // The same, reusing this object's memory when the size allows.
+  void compute(const cv::Mat& gray, cv::Point origin);
 
   bool empty() const { return sum_.empty(); }
   // The region covered, in level-image pixels: rectangles inside it can be summed.
@@ -27,7 +33,8 @@ class IntegralImage {
   const int32_t* row(int y) const { return sum_.ptr<int32_t>(y - origin_.y) - origin_.x; }
 
  private:
-  cv::Mat sum_;  // (h+1) x (w+1), CV_32S
+  cv::Mat buffer_;  // (h+1) x (w+1+kPadColumns), CV_32S
+  cv::Mat sum_;     // its first w+1 columns
   cv::Point origin_;
 };
 

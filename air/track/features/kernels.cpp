@@ -14,18 +14,14 @@ HWY_BEFORE_NAMESPACE();
 namespace aerie::track::kernels::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-void FeatureRun(const IntegralImage& ii, const RectFeature& f, int x, int y, int count, float* out) {
-  const hn::ScalableTag<float> df;
-  const hn::RebindToSigned<decltype(df)> di;
+// One feature over a run of samples with vectors of tag D: whole vectors only (the integral
+// image rows and the output rows have slack for the lanes past the run's end).
+template <class D>
+HWY_INLINE void FeatureVectors(D df, const RectFeature& f, const int32_t* const* top, const int32_t* const* bottom,
+                               int count, float* o) {
+  const hn::RebindToSigned<D> di;
   const int N = static_cast<int>(hn::Lanes(df));
-  const int32_t* top[RectFeature::kMaxRects];
-  const int32_t* bottom[RectFeature::kMaxRects];
-  for (int r = 0; r < f.count; ++r) {
-    top[r] = ii.row(y + f.rects[r].y) + x + f.rects[r].x;
-    bottom[r] = ii.row(y + f.rects[r].y + f.rects[r].h) + x + f.rects[r].x;
-  }
-  int i = 0;
-  for (; i + N <= count; i += N) {
+  for (int i = 0; i < count; i += N) {
     auto acc = hn::Zero(df);
     for (int r = 0; r < f.count; ++r) {
       const int w = f.rects[r].w;
@@ -34,15 +30,39 @@ void FeatureRun(const IntegralImage& ii, const RectFeature& f, int x, int y, int
                              hn::Add(hn::LoadU(di, bottom[r] + i), hn::LoadU(di, top[r] + i + w)));
       acc = hn::MulAdd(hn::ConvertTo(df, s), hn::Set(df, f.rects[r].weight), acc);
     }
-    hn::StoreU(acc, df, out + i);
+    hn::StoreU(acc, df, o + i);
   }
-  for (; i < count; ++i) {
-    float acc = 0;
+}
+
+void FeaturesRun(const ChannelImages& ch, const RectFeature* const* features, size_t nf, const SampleRun& run,
+                 float* out, size_t stride) {
+  const hn::CappedTag<float, kOutputPad> wide;  // at most 16 lanes: the padding of rows and outputs
+  const hn::CappedTag<float, 8> narrow;
+  const int n_wide = static_cast<int>(hn::Lanes(wide)), n_narrow = static_cast<int>(hn::Lanes(narrow));
+  for (size_t k = 0; k < nf; ++k) {
+    const RectFeature& f = *features[k];
+    const IntegralImage& ii = ch[f.channel];
+    const int32_t* top[RectFeature::kMaxRects];
+    const int32_t* bottom[RectFeature::kMaxRects];
     for (int r = 0; r < f.count; ++r) {
-      const int w = f.rects[r].w;
-      acc += f.rects[r].weight * static_cast<float>(bottom[r][i + w] - bottom[r][i] - top[r][i + w] + top[r][i]);
+      top[r] = ii.row(run.y + f.rects[r].y) + run.x + f.rects[r].x;
+      bottom[r] = ii.row(run.y + f.rects[r].y + f.rects[r].h) + run.x + f.rects[r].x;
     }
-    out[i] = acc;
+    float* o = out + k * stride;
+    if (run.count * 2 < n_narrow) {  // short runs (random negatives, small discs): scalar
+      for (int i = 0; i < run.count; ++i) {
+        float acc = 0;
+        for (int r = 0; r < f.count; ++r) {
+          const int w = f.rects[r].w;
+          acc += f.rects[r].weight * static_cast<float>(bottom[r][i + w] - bottom[r][i] - top[r][i + w] + top[r][i]);
+        }
+        o[i] = acc;
+      }
+    } else if (run.count <= n_narrow || n_wide == n_narrow || run.count % n_wide <= n_narrow / 2) {
+      FeatureVectors(narrow, f, top, bottom, run.count, o);
+    } else {
+      FeatureVectors(wide, f, top, bottom, run.count, o);
+    }
   }
 }
 
@@ -69,32 +89,28 @@ void AddLogRatio(const float* v, size_t n, float mu1, float sigma1, float mu0, f
   }
 }
 
-double SoftplusSum(const float* H, const float* h, size_t n) {
-  // softplus(z) = max(z, 0) + log(1 + exp(-|z|)); the second terms are multiplied per lane
-  // (each factor is in [1, 2]) and turned into one log per 32 steps, so the loop needs one
-  // exp per entry and no log.
-  const hn::ScalableTag<float> d;
+void SoftplusSums(const float* H, const float* h, size_t n, size_t M, size_t stride, double* S) {
+  // Vectorised over the weak classifiers m. softplus(z) = max(z, 0) + log(1 + exp(-|z|)); the
+  // second terms are multiplied per lane (each factor is in [1, 2]) and turned into one log per
+  // 64 instances, so the loop needs one exp per entry and no log.
+  const hn::CappedTag<float, 16> d;  // M is a multiple of 16
   const size_t N = hn::Lanes(d);
   const auto one = hn::Set(d, 1.0f), zero = hn::Zero(d);
-  auto linear = zero, product = one;
-  double logs = 0;
-  size_t i = 0, steps = 0;
-  for (; i + N <= n; i += N) {
-    const auto z = hn::Add(hn::LoadU(d, H + i), hn::LoadU(d, h + i));
-    linear = hn::Add(linear, hn::Max(z, zero));
-    product = hn::Mul(product, hn::Add(one, hn::Exp(d, hn::Neg(hn::Abs(z)))));
-    if (++steps == 32) {
-      logs += hn::GetLane(hn::SumOfLanes(d, hn::Log(d, product)));
-      product = one;
-      steps = 0;
+  HWY_ALIGN float lanes[16];
+  for (size_t m = 0; m < M; m += N) {
+    auto linear = zero, product = one, logs = zero;
+    for (size_t j = 0; j < n; ++j) {
+      const auto z = hn::Add(hn::Set(d, H[j]), hn::LoadU(d, h + j * stride + m));
+      linear = hn::Add(linear, hn::Max(z, zero));
+      product = hn::Mul(product, hn::Add(one, hn::Exp(d, hn::Neg(hn::Abs(z)))));
+      if ((j & 63) == 63) {
+        logs = hn::Add(logs, hn::Log(d, product));
+        product = one;
+      }
     }
+    hn::Store(hn::Add(hn::Add(linear, logs), hn::Log(d, product)), d, lanes);
+    for (size_t l = 0; l < N && m + l < M; ++l) S[m + l] = lanes[l];
   }
-  double sum = logs + hn::GetLane(hn::SumOfLanes(d, hn::Add(linear, hn::Log(d, product))));
-  for (; i < n; ++i) {
-    const double z = static_cast<double>(H[i]) + h[i];
-    sum += std::max(z, 0.0) + std::log1p(std::exp(-std::abs(z)));
-  }
-  return sum;
 }
 
 }  // namespace aerie::track::kernels::HWY_NAMESPACE
@@ -103,18 +119,21 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace aerie::track::kernels {
 
-HWY_EXPORT(FeatureRun);
+HWY_EXPORT(FeaturesRun);
 HWY_EXPORT(AddLogRatio);
-HWY_EXPORT(SoftplusSum);
+HWY_EXPORT(SoftplusSums);
 
-void feature_run(const IntegralImage& ii, const RectFeature& f, int x, int y, int count, float* out) {
-  HWY_DYNAMIC_DISPATCH(FeatureRun)(ii, f, x, y, count, out);
+void features_run(const ChannelImages& ch, const RectFeature* const* features, size_t nf, const SampleRun& run,
+                  float* out, size_t stride) {
+  HWY_DYNAMIC_DISPATCH(FeaturesRun)(ch, features, nf, run, out, stride);
 }
 void add_log_ratio(const float* v, size_t n, float mu1, float sigma1, float mu0, float sigma0, float log_floor,
                    float* acc) {
   HWY_DYNAMIC_DISPATCH(AddLogRatio)(v, n, mu1, sigma1, mu0, sigma0, log_floor, acc);
 }
-double softplus_sum(const float* H, const float* h, size_t n) { return HWY_DYNAMIC_DISPATCH(SoftplusSum)(H, h, n); }
+void softplus_sums(const float* H, const float* h, size_t n, size_t M, size_t stride, double* S) {
+  HWY_DYNAMIC_DISPATCH(SoftplusSums)(H, h, n, M, stride, S);
+}
 
 }  // namespace aerie::track::kernels
 #endif

@@ -8,9 +8,14 @@
 
 namespace aerie::track::kernels {
 
-// out[i] = sum_r weight_r * rectsum(x + i + rx_r, y + ry_r, w_r, h_r) for i in [0, count):
-// one feature over one run of samples.
-void feature_run(const IntegralImage& ii, const RectFeature& f, int x, int y, int count, float* out);
+// Lanes of slack every output row of features_run needs past its last sample.
+constexpr size_t kOutputPad = 16;
+
+// For each feature k: out[k * stride + i] = sum_r weight_r * rectsum(run.x + i + rx_r, run.y + ry_r,
+// w_r, h_r) over the channel of the feature, i in [0, run.count). Vector stores may write up to
+// kOutputPad - 1 entries past run.count (later runs overwrite them; the last run's land in the padding).
+void features_run(const ChannelImages& ch, const RectFeature* const* features, size_t nf, const SampleRun& run,
+                  float* out, size_t stride);
 
 // acc[i] += max(log N(v[i]; mu1, sigma1), floor) - max(log N(v[i]; mu0, sigma0), floor):
 // the log-ratio of one Gaussian naive Bayes / weak classifier term (eqs. 3.20, 3.28).
@@ -18,8 +23,9 @@ void feature_run(const IntegralImage& ii, const RectFeature& f, int x, int y, in
 void add_log_ratio(const float* v, size_t n, float mu1, float sigma1, float mu0, float sigma0, float log_floor,
                    float* acc);
 
-// sum_j softplus(H[j] + h[j]) = -sum_j log(1 - sigmoid(H[j] + h[j])) over n entries: the
-// negative log-probability that none of a bag's instances is positive (Algorithm 2, line 10).
-double softplus_sum(const float* H, const float* h, size_t n);
+// For every weak classifier m in [0, M): S[m] = sum_j softplus(H[j] + h[j * stride + m]) over the
+// n instances j of a bag, softplus(z) = -log(1 - sigmoid(z)): the negative log-probability that
+// none of the instances is positive (Algorithm 2, lines 8-10). M must be a multiple of 16.
+void softplus_sums(const float* H, const float* h, size_t n, size_t M, size_t stride, double* S);
 
 }  // namespace aerie::track::kernels

@@ -10,6 +10,12 @@
 namespace aerie::track {
 namespace {
 
+// Scratch rows for the kernels, one per thread (trackers may run in several threads).
+cv::Mat& padded_buffer() {
+  thread_local cv::Mat buffer;
+  return buffer;
+}
+
 void check_box(cv::Size box, int min_rects, int max_rects, const char* what) {
   if (box.width < 4 || box.height < 4)
     throw std::invalid_argument(std::string(what) + ": sample box " + std::to_string(box.width) + "x" +
@@ -104,13 +110,20 @@ cv::Size features_extent(const std::vector<RectFeature>& features) {
 
 void evaluate_features(const ChannelImages& ch, const std::vector<RectFeature>& features, const std::vector<int>& which,
                        const SampleSet& samples, cv::Mat& out) {
-  out.create(static_cast<int>(which.size()), static_cast<int>(samples.size()), CV_32F);
+  // Rows padded for the kernel's whole-vector stores; `out` is the view of the valid columns.
+  const int n = static_cast<int>(samples.size());
+  cv::Mat& buffer = padded_buffer();
+  const cv::Size need(n + static_cast<int>(kernels::kOutputPad), static_cast<int>(which.size()));
+  if (buffer.rows < need.height || buffer.cols < need.width) buffer.create(std::max(need.height, buffer.rows), std::max(need.width, buffer.cols), CV_32F);
+  std::vector<const RectFeature*> fs;
   cv::Size extent(0, 0);
-  for (int k : which)
+  for (int k : which) {
+    fs.push_back(&features[k]);
     for (int r = 0; r < features[k].count; ++r) {
       extent.width = std::max(extent.width, features[k].rects[r].x + features[k].rects[r].w);
       extent.height = std::max(extent.height, features[k].rects[r].y + features[k].rects[r].h);
     }
+  }
   const cv::Rect roi = ch.roi();
   int first = 0;
   for (const SampleRun& run : samples.runs()) {
@@ -118,11 +131,10 @@ void evaluate_features(const ChannelImages& ch, const std::vector<RectFeature>& 
     if (run.x < roi.x || run.y < roi.y || run.x + run.count - 1 + extent.width > roi.x + roi.width ||
         run.y + extent.height > roi.y + roi.height)
       throw std::logic_error("evaluate_features: samples reach outside the integral image");
-    for (size_t k = 0; k < which.size(); ++k)
-      kernels::feature_run(ch[features[which[k]].channel], features[which[k]], run.x, run.y, run.count,
-                           out.ptr<float>(static_cast<int>(k)) + first);
+    kernels::features_run(ch, fs.data(), fs.size(), run, buffer.ptr<float>(0) + first, buffer.step1());
     first += run.count;
   }
+  buffer(cv::Rect(0, 0, n, need.height)).copyTo(out);
 }
 
 void evaluate_features(const ChannelImages& ch, const std::vector<RectFeature>& features, const SampleSet& samples,

@@ -9,9 +9,7 @@
 
 namespace aerie::track {
 namespace {
-constexpr size_t kPad = 16;  // SIMD row padding (covers 512-bit vectors of floats)
-// Padding instances have h = -1e4: sigmoid(H + h) = 0, so they add nothing to a bag.
-constexpr float kNoInstance = -1e4f;
+constexpr size_t kPad = 16;  // the likelihood kernel works on 16 weak classifiers at a time
 size_t padded(int n) { return (static_cast<size_t>(n) + kPad - 1) / kPad * kPad; }
 }  // namespace
 
@@ -65,31 +63,36 @@ void MilBoost::update(const cv::Mat& positives, const cv::Mat& negatives) {
 }
 
 void MilBoost::select(const cv::Mat& positives, const cv::Mat& negatives) {
-  const size_t np = padded(positives.cols), nn = padded(negatives.cols);
-  h_pos_.assign(pool_ * np, kNoInstance);
-  h_neg_.assign(pool_ * nn, kNoInstance);
+  // Weak classifier outputs h_m(S_ij), instance-major (row j holds every m) so that the
+  // likelihoods of all M candidates are computed together, 16 lanes at a time.
+  const size_t mp = padded(pool_);
+  const int np = positives.cols, nn = negatives.cols;
+  h_pos_.assign(np * mp, 0.0f);
+  h_neg_.assign(nn * mp, 0.0f);
   const float floor = static_cast<float>(log_floor_);
+  std::vector<float> row(std::max(np, nn));
+  auto fill = [&](const cv::Mat& f, int n, std::vector<float>& h, int m) {
+    std::fill(row.begin(), row.begin() + n, 0.0f);
+    kernels::add_log_ratio(f.ptr<float>(m), n, pos_[m].mu, pos_[m].sigma, neg_[m].mu, neg_[m].sigma, floor, row.data());
+    for (int j = 0; j < n; ++j) h[j * mp + m] = row[j];
+  };
   for (int m = 0; m < pool_; ++m) {
-    float* hp = &h_pos_[m * np];
-    float* hn = &h_neg_[m * nn];
-    std::fill(hp, hp + positives.cols, 0.0f);
-    std::fill(hn, hn + negatives.cols, 0.0f);
-    kernels::add_log_ratio(positives.ptr<float>(m), positives.cols, pos_[m].mu, pos_[m].sigma, neg_[m].mu,
-                           neg_[m].sigma, floor, hp);
-    kernels::add_log_ratio(negatives.ptr<float>(m), negatives.cols, pos_[m].mu, pos_[m].sigma, neg_[m].mu,
-                           neg_[m].sigma, floor, hn);
+    fill(positives, np, h_pos_, m);
+    fill(negatives, nn, h_neg_, m);
   }
   H_pos_.assign(np, 0.0f);
   H_neg_.assign(nn, 0.0f);
+  std::vector<double> s_pos(mp), s_neg(mp);
   selected_.clear();
   std::vector<char> taken(pool_, 0);
-  for (int k = 0; k < k_; ++k) {
+  for (int k = 0; k < k_; ++k) {  // Algorithm 2, lines 3-17
+    kernels::softplus_sums(H_pos_.data(), h_pos_.data(), np, mp, mp, s_pos.data());
+    kernels::softplus_sums(H_neg_.data(), h_neg_.data(), nn, mp, mp, s_neg.data());
     int best = -1;
     double best_l = -std::numeric_limits<double>::infinity();
     for (int m = 0; m < pool_; ++m) {
       if (taken[m]) continue;
-      const double l = bag_log_likelihood(kernels::softplus_sum(H_pos_.data(), &h_pos_[m * np], np),
-                                          kernels::softplus_sum(H_neg_.data(), &h_neg_[m * nn], nn));
+      const double l = bag_log_likelihood(s_pos[m], s_neg[m]);
       if (l > best_l || best < 0) {
         best_l = l;
         best = m;
@@ -97,8 +100,8 @@ void MilBoost::select(const cv::Mat& positives, const cv::Mat& negatives) {
     }
     taken[best] = 1;
     selected_.push_back(best);
-    for (int j = 0; j < positives.cols; ++j) H_pos_[j] += h_pos_[best * np + j];
-    for (int j = 0; j < negatives.cols; ++j) H_neg_[j] += h_neg_[best * nn + j];
+    for (int j = 0; j < np; ++j) H_pos_[j] += h_pos_[j * mp + best];
+    for (int j = 0; j < nn; ++j) H_neg_[j] += h_neg_[j * mp + best];
   }
 }
 

@@ -48,7 +48,7 @@ class MilBoost {
   std::vector<float> sigma_floor_;
   std::vector<Gaussian> pos_, neg_;
   std::vector<int> selected_;
-  // Scratch: weak outputs of the pool per instance (rows padded to a multiple of 16) and H.
+  // Scratch: weak outputs h_m(S_ij) (instance-major, rows padded to a multiple of 16) and H_ij.
   std::vector<float> h_pos_, h_neg_, H_pos_, H_neg_;
 };
 

@@ -113,11 +113,15 @@ TEST(RectFeatures, EvaluationMatchesBruteForceOnEveryChannel) {
       EXPECT_LE(f.rects[r].y + f.rects[r].h, box.height);
     }
   }
-  // a 19-long run exercises the vector body and the scalar tail, singletons the tail only
+  // runs of 19, 10, 6 and 3 samples and singletons: every kernel path (wide and narrow
+  // vectors with lanes past the run's end, scalar)
   SampleSet samples;
   for (int x = 12; x < 31; ++x) samples.add(x, 25);
-  samples.add(40, 60);
-  samples.add(70, 22);
+  for (int x = 14; x < 24; ++x) samples.add(x, 30);
+  for (int x = 20; x < 26; ++x) samples.add(x, 33);
+  for (int x = 40; x < 43; ++x) samples.add(x, 40);
+  samples.add(40, 48);
+  samples.add(68, 22);
   cv::Mat out;
   evaluate_features(ch, features, samples, out);
   ASSERT_EQ(out.rows, static_cast<int>(features.size()));
@@ -138,6 +142,7 @@ TEST(RectFeatures, EvaluationMatchesBruteForceOnEveryChannel) {
   evaluate_features(ch, features, {5, 2}, samples, sub);
   EXPECT_EQ(sub.at<float>(0, 3), out.at<float>(5, 3));
   EXPECT_EQ(sub.at<float>(1, 20), out.at<float>(2, 20));
+  EXPECT_EQ(sub.at<float>(1, 39), out.at<float>(2, 39));
   // a sample reaching outside the integral image is a programming error, not a silent read
   SampleSet outside;
   outside.add(origin.x + size.width - 5, 25);
@@ -172,15 +177,21 @@ TEST(RectFeatures, ScaledFeaturesKeepValuesComparable) {
   EXPECT_GE(sf.footprint(1.6).height, 48);
 }
 
-TEST(Kernels, SoftplusSumMatchesScalarReference) {
-  std::vector<float> H(37), h(37);
-  for (int i = 0; i < 37; ++i) {
-    H[i] = static_cast<float>(std::sin(i) * 30);
-    h[i] = static_cast<float>(std::cos(3 * i) * 20 - 5);
+TEST(Kernels, SoftplusSumsMatchScalarReference) {
+  // 37 instances x 32 weak classifiers (row j holds every m), more than 64 instances too
+  for (size_t n : {37u, 150u}) {
+    const size_t M = 32;
+    std::vector<float> H(n), h(n * M);
+    for (size_t j = 0; j < n; ++j) H[j] = static_cast<float>(std::sin(j) * 30);
+    for (size_t i = 0; i < h.size(); ++i) h[i] = static_cast<float>(std::cos(3.0 * i) * 20 - 5);
+    std::vector<double> S(M);
+    kernels::softplus_sums(H.data(), h.data(), n, M, M, S.data());
+    for (size_t m = 0; m < M; ++m) {
+      double expect = 0;
+      for (size_t j = 0; j < n; ++j) expect += std::log1p(std::exp(static_cast<double>(H[j]) + h[j * M + m]));
+      EXPECT_NEAR(S[m], expect, 1e-5 * expect + 1e-5) << "m " << m << " n " << n;
+    }
   }
-  double expect = 0;
-  for (int i = 0; i < 37; ++i) expect += std::log1p(std::exp(static_cast<double>(H[i]) + h[i]));
-  EXPECT_NEAR(kernels::softplus_sum(H.data(), h.data(), H.size()), expect, 1e-4 * expect);
 }
 
 TEST(Channels, UnknownChannelNameIsAnError) {
