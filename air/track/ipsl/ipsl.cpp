@@ -79,10 +79,10 @@ void validate(const HierarchicalIpslParams& p) {
   require(p.particles >= 1, what, "particles", p.particles);
   require(std::isfinite(p.reject_ratio) && p.reject_ratio >= 0 && p.reject_ratio < 1, what, "reject_ratio",
           p.reject_ratio);
-  require(std::isfinite(p.min_range_factor) && p.min_range_factor >= 0, what, "min_range_factor",
-          p.min_range_factor);
-  require(std::isfinite(p.max_range_factor) && p.max_range_factor >= p.min_range_factor, what,
-          "max_range_factor", p.max_range_factor);
+  require(std::isfinite(p.min_range) && p.min_range >= 0, what, "min_range", p.min_range);
+  require(std::isfinite(p.max_range) && p.max_range >= p.min_range, what, "max_range", p.max_range);
+  require(std::isfinite(p.min_theta_factor) && p.min_theta_factor >= 0 && p.min_theta_factor <= 1, what,
+          "min_theta_factor", p.min_theta_factor);
   require(p.coarsest_block_size >= 1, what, "coarsest_block_size", p.coarsest_block_size);
   validate_common(what, p.sigma, p.appearance, p.recovery);
 }
@@ -105,8 +105,9 @@ HierarchicalIpslParams hierarchical_ipsl_params_from_config(const util::Config& 
   p.max_levels = c.get("max_levels", p.max_levels);
   p.particles = c.get("particles", p.particles);
   p.reject_ratio = c.get("reject_ratio", p.reject_ratio);
-  p.min_range_factor = c.get("min_range_factor", p.min_range_factor);
-  p.max_range_factor = c.get("max_range_factor", p.max_range_factor);
+  p.min_range = c.get("min_range", p.min_range);
+  p.max_range = c.get("max_range", p.max_range);
+  p.min_theta_factor = c.get("min_theta_factor", p.min_theta_factor);
   p.coarsest_block_size = c.get("coarsest_block_size", p.coarsest_block_size);
   read_common(c, p.sigma, p.appearance, p.recovery);
   try {
@@ -176,21 +177,27 @@ void clamp_pose(Similarity& s, const cv::Size& image, const cv::Size2d& template
 }
 
 // One random-walk step (eq. 3.7) with standard deviations `sigma` (x, y in full-resolution
-// pixels); a zero sigma leaves that parameter alone. Returns log N(step; 0, Psi) up to a constant.
-double random_walk(Similarity& s, const MotionSigma& sigma, std::mt19937_64& rng) {
+// pixels, scale as a log step); a zero sigma leaves that parameter alone.
+void random_walk(Similarity& s, const MotionSigma& sigma, std::mt19937_64& rng) {
   std::normal_distribution<double> n01;
-  double log_prior = 0;
-  auto step = [&](double sd) {
-    if (sd <= 0) return 0.0;
-    const double z = n01(rng);
-    log_prior -= 0.5 * z * z;
-    return sd * z;
-  };
+  auto step = [&](double sd) { return sd > 0 ? sd * n01(rng) : 0.0; };
   s.x += step(sigma.x);
   s.y += step(sigma.y);
   s.scale *= std::exp(step(sigma.scale));
   s.theta += step(sigma.theta);
-  return log_prior;
+}
+
+// log p(X_k | X_{k-1}) of eq. 3.6 under the random walk of eq. 3.7, up to a constant.
+double log_motion_prior(const Similarity& x, const Similarity& prev, const MotionSigma& psi) {
+  double lp = 0;
+  auto term = [&](double d, double sd) {
+    if (sd > 0) lp -= 0.5 * (d / sd) * (d / sd);
+  };
+  term(x.x - prev.x, psi.x);
+  term(x.y - prev.y, psi.y);
+  term(std::log(x.scale / prev.scale), psi.scale);
+  term(x.theta - prev.theta, psi.theta);
+  return lp;
 }
 
 // Systematic resampling: indices of `n` particles drawn in proportion to exp(log_weight).
@@ -301,8 +308,9 @@ TrackState IpslTracker::update(const cv::Mat& frame) {
   std::vector<Particle> next(parents.size());
   for (size_t i = 0; i < parents.size(); ++i) {
     next[i].pose = particles_[parents[i]].pose;
-    next[i].log_prior = random_walk(next[i].pose, sigma, rng_);
+    random_walk(next[i].pose, sigma, rng_);
     clamp_pose(next[i].pose, frame_size_, state_.initial_size);
+    next[i].log_prior = log_motion_prior(next[i].pose, state_.pose, sigma);
   }
   particles_ = std::move(next);
 
@@ -383,10 +391,15 @@ TrackState HierarchicalIpslTracker::update(const cv::Mat& frame) {
   {
     const MotionSigma s = step_sigma(coarsest);
     for (size_t i = 1; i < particles.size(); ++i) {
-      particles[i].log_prior = random_walk(particles[i].pose, s, rng_);
+      random_walk(particles[i].pose, s, rng_);
       clamp_pose(particles[i].pose, frame_size_, state_.initial_size);
     }
   }
+  // Psi of eq. 3.7 for the prior of eq. 3.6: the coarsest level's translation range, rotation
+  // and scale steps.
+  const double coarsest_px = std::ldexp(1.0, coarsest);
+  const MotionSigma psi{range_x * coarsest_px, range_y * coarsest_px, params_.sigma.scale, params_.sigma.theta};
+  const Similarity previous = state_.pose;
 
   std::vector<LevelStats> stats;
   Eigen::MatrixXf obs;
@@ -394,6 +407,7 @@ TrackState HierarchicalIpslTracker::update(const cv::Mat& frame) {
     const int patch = a.patch_size >> p;
     obs = observe(pyramid_, p + octave, particles, state_.initial_size, patch, a.normalize_patches);
     score_particles(*levels_[p], obs, particles);
+    for (auto& q : particles) q.log_prior = log_motion_prior(q.pose, previous, psi);
     // Rank by the posterior of eq. 3.6 (stable: ties keep their order, for determinism).
     std::vector<size_t> order(particles.size());
     std::iota(order.begin(), order.end(), 0);
@@ -421,35 +435,29 @@ TrackState HierarchicalIpslTracker::update(const cv::Mat& frame) {
     // eq. 3.15: the critical particle (best rejected) sets the next level's search range,
     // sigma^{p-1} = 2 H^p (H in level-p pixels, sigma in level-(p-1) pixels).
     const double level_px = std::ldexp(1.0, p);
-    const double lo = params_.min_range_factor, hi = params_.max_range_factor;
+    const double lo = params_.min_range, hi = params_.max_range;
+    const double theta_lo = params_.min_theta_factor * params_.sigma.theta, theta_hi = params_.sigma.theta;
     if (rejected > 0) {
       const Particle& critical = particles[order[n - rejected]];
-      range_x = std::clamp(pyramid::next_search_range(std::abs(critical.pose.x - best.pose.x) / level_px),
-                           lo * params_.sigma.x, hi * params_.sigma.x);
-      range_y = std::clamp(pyramid::next_search_range(std::abs(critical.pose.y - best.pose.y) / level_px),
-                           lo * params_.sigma.y, hi * params_.sigma.y);
-      range_theta = estimates_rotation(p)
-                        ? std::clamp(pyramid::next_search_range(std::abs(critical.pose.theta - best.pose.theta)),
-                                     lo * params_.sigma.theta, hi * params_.sigma.theta)
-                        : params_.sigma.theta;  // rotation enters at level p - 1
+      range_x = std::clamp(pyramid::next_search_range(std::abs(critical.pose.x - best.pose.x) / level_px), lo, hi);
+      range_y = std::clamp(pyramid::next_search_range(std::abs(critical.pose.y - best.pose.y) / level_px), lo, hi);
+      range_theta =
+          estimates_rotation(p)
+              ? std::clamp(pyramid::next_search_range(std::abs(critical.pose.theta - best.pose.theta)), theta_lo,
+                           theta_hi)
+              : params_.sigma.theta;  // rotation enters at level p - 1
     } else {
-      range_x = std::clamp(2 * range_x, lo * params_.sigma.x, hi * params_.sigma.x);
-      range_y = std::clamp(2 * range_y, lo * params_.sigma.y, hi * params_.sigma.y);
+      range_x = range_y = hi;
       range_theta = params_.sigma.theta;
     }
 
-    // eq. 3.12: survivors carry (x, y, theta, s) to level p - 1 and take one step of that
-    // level's motion model; the level's MAP particle passes unchanged.
+    // eq. 3.12: the level's estimate (its MAP particle) seeds level p - 1, which draws as many
+    // particles as survived the rejection, with that level's motion model and search range.
     const MotionSigma s = step_sigma(p - 1);
-    std::vector<Particle> next;
-    next.reserve(n - rejected);
-    for (int r = 0; r < n - rejected; ++r) {
-      Particle q{particles[order[r]].pose, particles[order[r]].log_prior, {}};
-      if (r > 0) {
-        q.log_prior += random_walk(q.pose, s, rng_);
-        clamp_pose(q.pose, frame_size_, state_.initial_size);
-      }
-      next.push_back(q);
+    std::vector<Particle> next(n - rejected, Particle{best.pose, 0, {}});
+    for (size_t r = 1; r < next.size(); ++r) {
+      random_walk(next[r].pose, s, rng_);
+      clamp_pose(next[r].pose, frame_size_, state_.initial_size);
     }
     particles = std::move(next);
   }

@@ -60,10 +60,12 @@ struct HierarchicalIpslParams {
   // step at the level where rotation enters (1, or 0 with two levels); scale = log-scale step
   // at level 0, the only level that estimates scale.
   MotionSigma sigma{4, 4, 0.02, 0.03};
-  // Bounds of the search ranges set by the critical particle (eq. 3.15) at the finer levels,
-  // as fractions of sigma.x / sigma.y (in each level's pixels) and sigma.theta.
-  double min_range_factor = 0.15;
-  double max_range_factor = 1.5;
+  // Bounds of the translation search range set by the critical particle (eq. 3.15) at the
+  // finer levels, in each level's pixels; the rotation range is bounded to
+  // [min_theta_factor, 1] * sigma.theta.
+  double min_range = 0.3;
+  double max_range = 1.0;
+  double min_theta_factor = 0.2;
   // N_B at the coarsest level; finer levels follow eq. 3.16 (at least 1).
   int coarsest_block_size = 8;
   AppearanceParams appearance;  // patch_size is the level-0 side; level p uses patch_size / 2^p
@@ -81,7 +83,7 @@ void validate(const HierarchicalIpslParams& p);
 // A particle: the similarity (x, y, s, theta) at some level's resolution.
 struct Particle {
   Similarity pose;
-  double log_prior = 0;       // log p(X_k | X_{k-1}) of the random-walk step that made it (eq. 3.7)
+  double log_prior = 0;       // log p(X_k | X_{k-1}): random walk (eq. 3.7) from the last estimate
   ObservationScore score;     // log p(O_k | X_k) and its terms (eqs. 3.8-3.10)
   double log_posterior() const { return score.log_likelihood + log_prior; }  // eq. 3.6
 };
