@@ -278,10 +278,25 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
         t.has_depth = t.X.z() > 0;
       }
     }
-    if (depth_frame) assign_depth(left, right, disparity, cur);
+    if (depth_frame) {
+      assign_depth(left, right, disparity, cur);
+    } else if (params_.refine_radius > 0) {
+      // Between dense maps the carried-over depth predicts where each tracked feature lies in
+      // the right image; a short search there measures its disparity afresh.
+      const double min_disparity = cam_.disparity(params_.max_depth_m);
+      for (size_t j = 0; j < cur.tracks.size(); ++j) {
+        Track& t = cur.tracks[j];
+        if (!t.has_depth) continue;
+        const cv::Point2f p = cur.feats.features[j].pt;
+        const auto d = refine_disparity(left, right, p, cam_.disparity(t.X.z()));
+        if (!d || *d < min_disparity) continue;
+        t.X = cam_.triangulate(p.x, p.y, *d);
+        t.disparity = *d;
+      }
+    }
 
     // 6. Keyframe: few tracks left from the last one, or enough motion since it (taken on a
-    //    frame with fresh depth, so that the bundle adjuster gets stereo observations).
+    //    frame with measured disparities, so that the bundle adjuster gets stereo observations).
     int tracked = 0;
     for (const auto& t : cur.tracks) tracked += std::binary_search(last_kf_tracks_.begin(), last_kf_tracks_.end(), t.id);
     const geometry::SE3 since = T_odom_last_kf_.inverse() * T_odom_cam_;
@@ -289,7 +304,7 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
                       since.translation().norm() > params_.keyframe_translation_m ||
                       geometry::rotation_angle(since.rotation_matrix()) * 180.0 / M_PI > params_.keyframe_rotation_deg;
     prev_ = std::move(cur);
-    if (want && depth_frame) {
+    if (want && (depth_frame || params_.refine_radius > 0)) {
       make_keyframe(utime, *prev_);
       r.keyframe = true;
     }

@@ -1,9 +1,10 @@
 #pragma once
 // The stereo visual odometry front end (thesis Fig. 4.4): per rectified stereo pair
 //   1. bucketed FAST + modified BRIEF on the left image (features/),
-//   2. dense disparity by SGBM_F on one of every `depth_every` pairs (sgbm_ctf/); features of
-//      the pairs in between keep the depth carried over from the last disparity map
-//      through their tracks (eq. 4.12),
+//   2. dense disparity by SGBM_F on one of every `depth_every` pairs (sgbm_ctf/), each feature's
+//      disparity refined at full resolution by a short SAD search around it; on the pairs in
+//      between, tracked features carry their depth over (eq. 4.12) and that depth, projected
+//      into the right image, seeds the same short search,
 //   3. matching to the previous left frame (Hamming, mutual + ratio checks, search around the
 //      position predicted by the previous motion),
 //   4. 2D+3D motion by LM (motion/), pose chained T_odom_{k+1} = T_odom_k * M^-1,
@@ -29,10 +30,10 @@
 namespace aerie::stereo {
 
 struct VoParams {
-  SgbmCtfParams depth;        // dense disparity (num_disparities = D)
+  SgbmCtfParams depth = default_depth();  // dense disparity (num_disparities = D)
   int depth_every = 2;        // dense depth on one of every N pairs (thesis: 2)
-  int depth_scale = 1;        // 1: dense depth at full resolution, 2: on the half-resolution pair
-  int refine_radius = 2;      // per-feature disparity refinement at full resolution: +- px (0 = off)
+  int depth_scale = 2;        // 1: dense depth at full resolution, 2: on the half-resolution pair
+  int refine_radius = 2;      // per-feature disparity search at full resolution: +- px (0 = off)
   int refine_half_window = 3; // SAD window (2 h + 1)^2 of that refinement
   double max_depth_m = 40.0;  // features farther than this count as 2D (no depth)
   FeatureParams features;
@@ -49,6 +50,11 @@ struct VoParams {
   bool ba_synchronous = false;  // wait for each BA (reproducible offline evaluation)
 
   void validate() const;  // throws std::invalid_argument naming the key
+  static SgbmCtfParams default_depth() {
+    SgbmCtfParams d;
+    d.sgm.num_disparities = 48;
+    return d;
+  }
 };
 
 enum class VoStatus { Ok, Initialising, Lost, Reset };
