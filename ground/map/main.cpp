@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-range", max_range, "sensor_model/max_range in metres (overrides the config)");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("aerie-map", opts.log_level);
+  aerie::bus::install_stop_handlers();  // early: a Ctrl-C while loading still saves at exit
 
   try {
     const auto ext = std::filesystem::path(save_path).extension();
