@@ -52,6 +52,7 @@ MapServiceConfig MapServiceConfig::from_config(const util::Config& cfg) {
   o.stereo.baseline_m = cfg.get("stereo.baseline_m", o.stereo.baseline_m);
   o.stereo.disparity_sigma_px = cfg.get("stereo.disparity_sigma_px", o.stereo.disparity_sigma_px);
   o.stereo.free_margin_sigmas = cfg.get("stereo.free_margin_sigmas", o.stereo.free_margin_sigmas);
+  o.stereo.weight_hits = cfg.get("stereo.weight_hits", o.stereo.weight_hits);
   o.visibility_if_occluded = cfg.get("visibility_if_occluded", o.visibility_if_occluded);
   try {
     o.validate();
