@@ -8,7 +8,7 @@ namespace aerie::sim {
 
 void require_known_keys(const util::Config& section, std::initializer_list<const char*> allowed) {
   const YAML::Node& n = section.node();
-  if (!n) return;
+  if (!n || n.IsNull()) return;
   if (!n.IsMap()) throw std::runtime_error(section.origin() + ": expected a map");
   for (const auto& kv : n) {
     const auto key = kv.first.as<std::string>();
