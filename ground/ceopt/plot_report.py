@@ -198,6 +198,7 @@ def plot_rmse(out):
                 for s in speeds]
         errs = [next((float(x["rmse_std_deg"]) for x in r if x["controller"] == c and float(x["speed"]) == s), np.nan)
                 for s in speeds]
+        errs = [0 if np.isnan(e) else e for e in errs]
         ax.bar(np.arange(len(speeds)) + i * w, vals, w, yerr=errs, color=COLORS.get(c), label=f"{c} (simulation)")
     for i, c in enumerate(["sf", "sfmf"]):
         ax.bar(np.arange(len(speeds)) + (len(controllers) + i) * w, [THESIS[c].get(s, np.nan) for s in speeds], w,
