@@ -39,11 +39,12 @@ std::vector<CeParameter> parameters_from(const util::Config& cfg, const std::str
 CeoptConfig default_ceopt_config() {
   CeoptConfig c;
   // Stage 1 from the hand-tuned factors (all 1, thesis 5.1.3).
-  c.stage1 = {{"Kp", 1.0, 2.0, 0.05, 10.0}, {"Kd", 1.0, 0.5, 0.001, 2.0}, {"Ki", 1.0, 1.0, -3.0, 3.0}};
+  // Initial sigmas of about half the box, so that the first iterations sample all of it.
+  c.stage1 = {{"Kp", 1.0, 5.0, 0.05, 10.0}, {"Kd", 1.0, 1.0, 0.001, 2.0}, {"Ki", 1.0, 3.0, -3.0, 3.0}};
   // Stage 2 from the initial (evenly spaced) positions of the sets the thesis optimises.
-  c.stage2 = {{"error.Left", -45.0, 20.0, -90.0, 0.0},        {"derivative.Negative", -10.0, 5.0, -20.0, 0.0},
-              {"integral.Negative", -5.0, 2.5, -10.0, 0.0},    {"yaw_rate.BigLeft", -67.5, 10.0, -90.0, 0.0},
-              {"yaw_rate.Left", -45.0, 10.0, -90.0, 0.0},      {"yaw_rate.LittleLeft", -22.5, 10.0, -90.0, 0.0}};
+  c.stage2 = {{"error.Left", -45.0, 45.0, -90.0, 0.0},        {"derivative.Negative", -10.0, 10.0, -20.0, 0.0},
+              {"integral.Negative", -5.0, 5.0, -10.0, 0.0},    {"yaw_rate.BigLeft", -67.5, 45.0, -90.0, 0.0},
+              {"yaw_rate.Left", -45.0, 45.0, -90.0, 0.0},      {"yaw_rate.LittleLeft", -22.5, 45.0, -90.0, 0.0}};
   return c;
 }
 

@@ -178,6 +178,7 @@ TEST(Config, TheShippedConfigIsTheDefaultAndErrorsNameTheKey) {
   for (size_t i = 0; i < cfg.stage2.size(); ++i) {
     EXPECT_EQ(cfg.stage2[i].name, def.stage2[i].name);
     EXPECT_EQ(cfg.stage2[i].mean, def.stage2[i].mean);
+    EXPECT_EQ(cfg.stage2[i].sigma, def.stage2[i].sigma);
   }
   EXPECT_EQ(cfg.training.scenario.scene.safe_area_m, 3.0);
   EXPECT_EQ(cfg.training.scenario.settle_band_deg, def.training.scenario.settle_band_deg);
