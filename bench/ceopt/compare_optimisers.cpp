@@ -202,6 +202,8 @@ int main(int argc, char** argv) {
       std::printf("%-6d %-15s %5zu %12.1f %12.1f %12.1f %12.1f %12.1f\n", key.first, key.second.c_str(), ts.size(), mean, mn, at(0.1),
                   at(0.25), at(0.5));
     }
+    conv.close();
+    sum.close();
     std::printf("load before %s, after %s\n", load_before.c_str(), read_loadavg().c_str());
     const std::string plot = std::string(AERIE_BENCH_CEOPT_DIR) + "/plot_convergence.py";
     const std::string cmd = "/usr/bin/python3 '" + plot + "' '" + out + "'";
