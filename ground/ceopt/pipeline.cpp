@@ -89,8 +89,9 @@ CeoptConfig ceopt_config_from(const util::Config& cfg) {
   c.stage1 = parameters_from(cfg, "stage1", c.stage1);
   c.stage2 = parameters_from(cfg, "stage2", c.stage2);
   const auto pr = cfg.section("prune");
-  sim::require_known_keys(pr, {"overlap_fraction"});
+  sim::require_known_keys(pr, {"overlap_fraction", "max_cost_increase"});
   c.prune.overlap_fraction = pr.get("overlap_fraction", c.prune.overlap_fraction);
+  c.prune_max_cost_increase = pr.get("max_cost_increase", c.prune_max_cost_increase);
 
   const auto ev = cfg.section("evaluation");
   sim::require_known_keys(ev, {"speeds", "runs_per_speed", "seed"});
@@ -127,8 +128,40 @@ TuningResult run_tuning(const CeoptConfig& cfg, ThreadPool& pool, const StageCal
   t.stage1 = run_stage(1, t.initial, cfg.stage1, cfg, pool, cb);
   if (t.stage1.ce.stop_reason == "cancelled") return t;
   t.stage2 = run_stage(2, t.stage1.controller, cfg.stage2, cfg, pool, cb);
-  t.pruned = flc::prune(t.stage2.controller, cfg.prune, &t.prune_report);
+  t.pruned = prune_verified(t.stage2.controller, cfg, &t.prune_report, &t.prune_steps);
   return t;
+}
+
+flc::FlcSpec prune_verified(const flc::FlcSpec& spec, const CeoptConfig& cfg, flc::PruneReport* report,
+                            std::vector<PruneStep>* steps) {
+  const double base = controller_cost(flc::Flc(spec), cfg.training);
+  flc::FlcSpec current = spec;
+  flc::PruneReport total;
+  for (const flc::Variable* v : {&spec.inputs[0], &spec.inputs[1], &spec.inputs[2], &spec.output}) {
+    flc::PruneOptions opt = cfg.prune;
+    opt.variables = {v->name};
+    flc::PruneReport r;
+    const flc::FlcSpec candidate = flc::prune(current, opt, &r);
+    if (r.removed_sets.empty()) continue;
+    PruneStep step{v->name, r.removed_sets, controller_cost(flc::Flc(current), cfg.training),
+                   controller_cost(flc::Flc(candidate), cfg.training), false};
+    step.accepted = cfg.prune_max_cost_increase < 0.0 || step.cost_after <= base * (1.0 + cfg.prune_max_cost_increase);
+    if (step.accepted) {
+      current = candidate;
+      total.removed_sets.insert(total.removed_sets.end(), r.removed_sets.begin(), r.removed_sets.end());
+    }
+    if (steps) steps->push_back(step);
+  }
+  auto sets = [](const flc::FlcSpec& s) {
+    return s.inputs[0].size() + s.inputs[1].size() + s.inputs[2].size() + s.output.size();
+  };
+  total.rules_before = static_cast<int>(spec.rules.size());
+  total.rules_after = static_cast<int>(current.rules.size());
+  total.sets_before = sets(spec);
+  total.sets_after = sets(current);
+  current.id = spec.id + "-pruned";
+  if (report) *report = total;
+  return current;
 }
 
 std::vector<ExperimentRun> run_experiment(const std::vector<std::pair<std::string, flc::FlcSpec>>& controllers,

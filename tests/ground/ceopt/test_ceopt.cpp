@@ -216,6 +216,16 @@ TEST(Pipeline, ShortTuningImprovesOnTheInitialControllerAndIsReproducible) {
   EXPECT_LT(t.stage1.ce.best_cost, p.cost({1.0}));
   EXPECT_LE(t.stage2.ce.best_cost, t.stage1.ce.best_cost * 1.5);
   EXPECT_NO_THROW(flc::Flc{t.pruned});
+  // Verified pruning: every tried merge is recorded with its cost; with no tolerance
+  // limit (< 0) all overlap merges are kept, as flc::prune does at once.
+  for (const auto& st : t.prune_steps) EXPECT_EQ(st.accepted, st.cost_after <= t.stage2.ce.best_cost * 1.1 + 1e-9) << st.variable;
+  CeoptConfig all = cfg;
+  all.prune_max_cost_increase = -1;
+  flc::PruneReport rep;
+  std::vector<PruneStep> steps;
+  const auto pruned_all = prune_verified(t.stage2.controller, all, &rep, &steps);
+  EXPECT_EQ(pruned_all.rules.size(), flc::prune(t.stage2.controller, cfg.prune).rules.size());
+  for (const auto& st : steps) EXPECT_TRUE(st.accepted);
   ThreadPool one(1);
   const auto again = run_tuning(cfg, one);
   EXPECT_EQ(again.stage2.ce.best, t.stage2.ce.best);
