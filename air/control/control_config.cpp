@@ -1,5 +1,6 @@
 #include "air/control/control_config.hpp"
 
+#include "common/bus/channels.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/sim/vehicle/scenario_config.hpp"
 
@@ -29,6 +30,7 @@ NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   const auto ch = cfg.section("channels");
   sim::require_known_keys(ch, {"pose", "params", "command"});
   o.pose_channel = !cli.pose_channel.empty() ? cli.pose_channel : ch.get<std::string>("pose", "");
+  if (o.pose_channel.empty()) o.pose_channel = input == "vo" ? channels::kVoPose : channels::kGtPose;
   o.params_channel = ch.get<std::string>("params", o.params_channel);
   o.command_channel = ch.get<std::string>("command", o.command_channel);
   o.rate_hz = cli.rate_hz.value_or(cfg.get("rate_hz", o.rate_hz));

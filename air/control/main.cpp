@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     spdlog::info("controller '{}' ({} rules), input {} on {}, CTRL_CMD at {} Hz, reference {} deg{}, stale after {} s",
                  setup.controller.id, setup.controller.rules.size(),
                  setup.options.input == control::NodeOptions::Input::kVoPose ? "vo" : "gt",
-                 setup.options.pose_channel.empty() ? "(default)" : setup.options.pose_channel, setup.options.rate_hz,
+                 setup.options.pose_channel, setup.options.rate_hz,
                  setup.options.control.reference_deg, setup.options.control.reference_relative ? " (relative)" : "",
                  setup.options.control.stale_timeout_s);
     bus::run(bus, status, [&] {
