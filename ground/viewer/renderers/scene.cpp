@@ -9,6 +9,7 @@
 #include <vtkFloatArray.h>
 #include <vtkGlyph3DMapper.h>
 #include <vtkLookupTable.h>
+#include <vtkCellData.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -252,14 +253,9 @@ void OctomapRenderer::subscribe(bus::Bus& bus) {
 }
 
 void OctomapRenderer::attach(Layout& layout) {
-  auto cube = vtkSmartPointer<vtkCubeSource>::New();
-  auto mapper = vtkSmartPointer<vtkGlyph3DMapper>::New();
-  mapper->SetSourceConnection(cube->GetOutputPort());
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
   mapper->SetInputData(vtkSmartPointer<vtkPolyData>::New());
-  mapper->SetScaleModeToScaleByMagnitude();
-  mapper->SetScaleArray("size");
-  mapper->SetScalarModeToUsePointFieldData();
-  mapper->SelectColorArray("height");
+  mapper->SetScalarModeToUseCellData();
   mapper->ScalarVisibilityOn();
   auto lut = vtkSmartPointer<vtkLookupTable>::New();
   lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
@@ -292,13 +288,17 @@ bool OctomapRenderer::update() {
   return true;
 }
 
+// Occupied voxels as one mesh of their visible faces: a face shared with another
+// occupied voxel is never seen and is left out, which keeps a 100k-voxel map to a few
+// hundred thousand triangles that software OpenGL draws at display rate.
 void OctomapRenderer::extract() {
   auto points = vtkSmartPointer<vtkPoints>::New();
-  auto size = vtkSmartPointer<vtkFloatArray>::New();
-  size->SetName("size");
+  points->SetDataTypeToFloat();
+  auto quads = vtkSmartPointer<vtkCellArray>::New();
   auto height = vtkSmartPointer<vtkFloatArray>::New();
   height->SetName("height");
   double zmin = 0, zmax = 1;
+  size_t voxels = 0;
   {
     std::lock_guard lock(map_->m);
     if (!map_->tree) return;
@@ -309,22 +309,40 @@ void OctomapRenderer::extract() {
     tree.getMetricMax(hi[0], hi[1], hi[2]);
     zmin = lo[2];
     zmax = std::max(hi[2], zmin + 1e-3);
+    static const int dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     for (auto it = tree.begin_leafs(depth); it != tree.end_leafs(); ++it) {
       if (!tree.isNodeOccupied(*it)) continue;
+      ++voxels;
       const auto c = it.getCoordinate();
-      points->InsertNextPoint(c.x(), c.y(), c.z());
-      size->InsertNextValue(static_cast<float>(it.getSize()));
-      height->InsertNextValue(c.z());
+      const float h = static_cast<float>(it.getSize() / 2);
+      for (const auto& d : dirs) {
+        const octomap::point3d n(c.x() + d[0] * (h + 1e-3f), c.y() + d[1] * (h + 1e-3f), c.z() + d[2] * (h + 1e-3f));
+        const auto* nb = tree.search(n, depth);
+        if (nb && tree.isNodeOccupied(nb)) continue;  // hidden face
+        // The face's four corners: the two axes orthogonal to d span it.
+        const int a = d[0] ? 1 : 0, b = d[2] ? 1 : 2;
+        vtkIdType ids[4];
+        const float s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int k = 0; k < 4; ++k) {
+          float p[3] = {c.x(), c.y(), c.z()};
+          for (int axis = 0; axis < 3; ++axis) p[axis] += d[axis] * h;
+          p[a] += s[k][0] * h;
+          p[b] += s[k][1] * h;
+          ids[k] = points->InsertNextPoint(p);
+        }
+        quads->InsertNextCell(4, ids);
+        height->InsertNextValue(c.z());
+      }
     }
   }
   auto poly = vtkSmartPointer<vtkPolyData>::New();
   poly->SetPoints(points);
-  poly->GetPointData()->AddArray(size);
-  poly->GetPointData()->AddArray(height);
-  auto* mapper = vtkGlyph3DMapper::SafeDownCast(actor_->GetMapper());
+  poly->SetPolys(quads);
+  poly->GetCellData()->SetScalars(height);
+  auto* mapper = vtkPolyDataMapper::SafeDownCast(actor_->GetMapper());
   mapper->SetInputData(poly);
   mapper->SetScalarRange(zmin, zmax);
-  shown_ = static_cast<size_t>(points->GetNumberOfPoints());
+  shown_ = voxels;
 }
 
 void OctomapRenderer::on_enabled(bool on) {
