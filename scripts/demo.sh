@@ -47,6 +47,14 @@ fi
 # --- Processes ---------------------------------------------------------------------
 mkdir -p logs
 LOG="logs/demo-$(date +%Y%m%d-%H%M%S).lcm"
+# The viewer renders off-screen but needs an X server: a private Xvfb unless one is set.
+xvfb_pid=""
+DEMO_DISPLAY=${DISPLAY:-}
+if [ -z "$DEMO_DISPLAY" ]; then
+  DEMO_DISPLAY=:$((90 + RANDOM % 100))
+  Xvfb "$DEMO_DISPLAY" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
+  xvfb_pid=$!
+fi
 capture=("$BIN/aerie-capture" --source sim --sim-trajectory demo --width 376 --height 240 --fps 20 --rate 1)
 [ "$duration" != 0 ] && capture+=(--duration "$duration")
 capture+=("${capture_extra[@]}")
@@ -58,6 +66,16 @@ capture+=("${capture_extra[@]}")
 #   "$BIN/aerie-track --config config/track.yaml"
 #   "$BIN/aerie-vo --config config/vo.yaml"
 EXTRA_PROCESSES=(
+  # air: track the helipad (initialised on its ground-truth box after 20 frames; 1 m pad)
+  "$BIN/aerie-track --camera CAM_LEFT --init-from-gt 20 --target-size 1.0"
+  # air: stereo visual odometry and compact depth
+  "$BIN/aerie-vo --config config/vo.yaml"
+  # air: the fuzzy heading controller on the VO heading
+  "$BIN/aerie-control --input vo"
+  # ground: the occupancy map, saved next to the log at the end
+  "$BIN/aerie-map --config config/map.yaml --save ${LOG%.lcm}-map.bt"
+  # ground: the dashboard, off-screen; its snapshot is written next to the log at the end
+  "env DISPLAY=$DEMO_DISPLAY $BIN/aerie-viewer --snapshot ${LOG%.lcm}-dashboard.png"
 )
 # ====================================================================================
 
@@ -85,6 +103,10 @@ cleanup() {
     sleep 0.5  # let the last datagrams reach the logger
     stop_pid "$logger_pid" lcm-logger
     logger_pid=""
+  fi
+  if [ -n "$xvfb_pid" ]; then
+    kill "$xvfb_pid" 2>/dev/null || true
+    xvfb_pid=""
   fi
 }
 trap cleanup EXIT
@@ -119,4 +141,8 @@ if [ "$status" -ne 0 ] && [ "$interrupted" -eq 0 ]; then
   echo "demo: aerie-capture failed (exit status $status)" >&2
   exit "$status"
 fi
+"$BIN/aerie-latency" "$LOG" || true
+for f in "${LOG%.lcm}-dashboard.png" "${LOG%.lcm}-map.bt"; do
+  [ -f "$f" ] && echo "demo: wrote $f"
+done
 echo "demo: replay with: lcm-logplayer $LOG   (inspect: $BIN/aerie-log info $LOG)"
