@@ -103,8 +103,12 @@ TEST_F(NodeTest, InitThenTracksEveryFrameWithTheSourceUtime) {
   EXPECT_NEAR(poses_.back().position[2], 200 * 0.8 / last.width, 1e-6);
   EXPECT_NEAR(poses_.back().position[2], 4.0, 0.4);  // the target keeps its size
   EXPECT_NEAR(poses_.back().position[0], (last.x - 120) / 200 * poses_.back().position[2], 1e-6);
-  EXPECT_EQ(node.counter("frames_received"), 16);  // frames 0 (idle) and 1 (init) are not tracked
-  EXPECT_EQ(node.counter("frames_processed") + node.counter("frames_skipped") + 2, node.counter("frames_received"));
+  EXPECT_EQ(node.counter("frames_received"), 16);
+  // Frame 0 (idle) is never tracked. Frame 1 is the INIT frame when the command and the
+  // frame reach the worker together; when the worker wakes on the command first, INIT
+  // takes frame 0 and frame 1 is tracked. Either way every other frame is accounted for.
+  const int64_t accounted = node.counter("frames_processed") + node.counter("frames_skipped");
+  EXPECT_TRUE(accounted == 14 || accounted == 15) << accounted;
 }
 
 TEST_F(NodeTest, BadMessagesAndCommandsAreCountedNotFatal) {
