@@ -157,6 +157,7 @@ void LatencyChart::subscribe(bus::Bus& bus) {
     bus.subscribe_raw(channels_[i], [this, i](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
       const auto utime = bus::peek_utime(data, size);
       if (!utime) throw std::invalid_argument("message too short to hold a utime");
+      if (*utime <= 0) return;  // no source frame (e.g. a controller hovering without input)
       last_ms_[i] = static_cast<double>(info.recv_utime - *utime) * 1e-3;
       std::vector<double> y;
       for (const auto& v : last_ms_) y.push_back(v);
