@@ -19,6 +19,8 @@ make_namespace() {  # make_namespace NAME
   ip netns exec "$NS" ip link set lo up
   ip netns exec "$NS" ip route add 224.0.0.0/4 dev lo
 }
+# Runs a command in the namespace. `ip netns exec` execs the command, so `in_ns ... &`
+# would give the pid of a subshell: background processes use `ip netns exec "$NS"` directly.
 in_ns() { ip netns exec "$NS" "$@"; }
 
 machine_note() {  # one line: the load when the figure was taken

@@ -10,7 +10,7 @@ OUT=${2:-$ROOT/build/default/bench/capture}
 mkdir -p "$OUT"
 make_namespace aerie-bench-lat
 echo "# $(machine_note)" | tee "$OUT/latency-machine.txt"
-in_ns "$BIN/aerie-bench-capture-latency" --lcm-url "$RECV_URL" --duration "$SECS" --out "$OUT/latency.csv" \
+ip netns exec "$NS" "$BIN/aerie-bench-capture-latency" --lcm-url "$RECV_URL" --duration "$SECS" --out "$OUT/latency.csv" \
   > "$OUT/latency.json" 2> "$OUT/latency-probe.txt" &
 probe=$!
 sleep 1

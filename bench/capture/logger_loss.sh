@@ -13,7 +13,7 @@ mkdir -p "$OUT"
 make_namespace aerie-bench-log
 LOG=$OUT/logger-loss.lcm
 echo "# $(machine_note); rmem_max $(sysctl -n net.core.rmem_max); logger URL $LOGGER_URL" | tee "$OUT/logger-loss-machine.txt"
-in_ns lcm-logger -f --quiet --lcm-url="$LOGGER_URL" "$LOG" &
+ip netns exec "$NS" lcm-logger -f --quiet --lcm-url="$LOGGER_URL" "$LOG" &
 logger=$!
 sleep 1
 in_ns "$BIN/aerie-capture" --lcm-url "$URL" --source euroc --path "$EUROC" \
@@ -22,8 +22,7 @@ in_ns "$BIN/aerie-capture" --lcm-url "$URL" --source euroc --path "$EUROC" \
 sleep 1
 kill -INT $logger
 wait $logger
-"$BIN/aerie-log" info "$LOG" | tee "$OUT/logger-loss-info.txt"
-"$BIN/aerie-log" info --json "$LOG" > "$OUT/logger-loss.json"
+"$BIN/aerie-log" info --json "$LOG" > "$OUT/logger-loss.json" || true
 published=$(grep -o 'published [0-9]* frames' "$OUT/logger-loss-capture.txt" | awk '{print $2}')
 $PY - "$OUT/logger-loss.json" "$published" <<'PYEOF'
 import json, sys
@@ -31,6 +30,8 @@ s = json.load(open(sys.argv[1])); published = int(sys.argv[2])
 lost = {c["channel"]: published - c["count"] for c in s["channels"] if c["channel"].startswith(("CAM_", "GT_"))}
 print(f"frames published: {published}; recorded per channel: " +
       ", ".join(f'{c["channel"]} {c["count"]}' for c in s["channels"]))
+print(f"duration {s['duration_s']:.1f} s, {s['file_size'] / 1e6:.0f} MB; max gap per channel: " +
+      ", ".join(f'{c["channel"]} {c["max_gap_s"]:.3f} s' for c in s["channels"]))
 print(f"messages lost (published - recorded): {lost}; sequence gaps: {s['dropped']}")
 PYEOF
 rm -f "$LOG"   # ~3.5 GB for 2 minutes; the summary stays in $OUT
