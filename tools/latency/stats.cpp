@@ -12,6 +12,11 @@ double percentile_sorted(const std::vector<double>& sorted, double q) {
   return sorted[k] + (pos - static_cast<double>(k)) * (sorted[k + 1] - sorted[k]);
 }
 
+double percentile(std::vector<double> values, double q) {
+  std::sort(values.begin(), values.end());
+  return percentile_sorted(values, q);
+}
+
 Summary summarize(std::vector<double> v) {
   Summary s;
   s.count = static_cast<int64_t>(v.size());

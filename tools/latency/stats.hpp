@@ -14,5 +14,7 @@ struct Summary {
 Summary summarize(std::vector<double> values);
 // q in [0, 1]; `sorted` must be sorted ascending and non-empty.
 double percentile_sorted(const std::vector<double>& sorted, double q);
+// The same for any non-empty sample.
+double percentile(std::vector<double> values, double q);
 
 }  // namespace aerie::latency

@@ -8,9 +8,11 @@
 #include <numeric>
 #include <set>
 
+#include "tools/latency/stats.hpp"
 #include "tools/link/link_model.hpp"
 
 using namespace aerie::link;
+namespace latency = aerie::latency;
 
 namespace {
 
@@ -48,13 +50,6 @@ Result run(DirectionConfig cfg, int n, int64_t period_us, size_t size = 100) {
   while (d.next_event_us() >= 0) collect(t = std::max(t, d.next_event_us()));
   r.counters = d.counters();
   return r;
-}
-
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const size_t k = static_cast<size_t>(pos);
-  return v[k] + (pos - static_cast<double>(k)) * (v[std::min(k + 1, v.size() - 1)] - v[k]);
 }
 
 double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
@@ -95,9 +90,9 @@ TEST(LinkModel, NormalJitterHasTheConfiguredDistribution) {
   ASSERT_EQ(r.delay_ms.size(), 10000u);
   EXPECT_NEAR(mean(r.delay_ms), 20.0, 0.2);
   EXPECT_NEAR(stddev(r.delay_ms), 5.0, 0.2);
-  EXPECT_NEAR(quantile(r.delay_ms, 0.10), 20.0 - 1.2816 * 5, 0.5);
-  EXPECT_NEAR(quantile(r.delay_ms, 0.50), 20.0, 0.5);
-  EXPECT_NEAR(quantile(r.delay_ms, 0.90), 20.0 + 1.2816 * 5, 0.5);
+  EXPECT_NEAR(latency::percentile(r.delay_ms, 0.10), 20.0 - 1.2816 * 5, 0.5);
+  EXPECT_NEAR(latency::percentile(r.delay_ms, 0.50), 20.0, 0.5);
+  EXPECT_NEAR(latency::percentile(r.delay_ms, 0.90), 20.0 + 1.2816 * 5, 0.5);
   // Jitter larger than the spacing reorders when allowed.
   EXPECT_FALSE(std::is_sorted(r.serials.begin(), r.serials.end()));
 }
@@ -120,7 +115,7 @@ TEST(LinkModel, UniformAndExponentialJitter) {
   EXPECT_NEAR(mean(e.delay_ms), 34.0, 0.3);  // delay + mean of Exp(jitter)
   EXPECT_NEAR(stddev(e.delay_ms), 4.0, 0.3);
   EXPECT_GE(*std::min_element(e.delay_ms.begin(), e.delay_ms.end()), 30.0 - 1e-3);
-  EXPECT_NEAR(quantile(e.delay_ms, 0.5), 30.0 + 4 * std::log(2.0), 0.3);
+  EXPECT_NEAR(latency::percentile(e.delay_ms, 0.5), 30.0 + 4 * std::log(2.0), 0.3);
 }
 
 TEST(LinkModel, WithoutReorderDeliveriesKeepTheArrivalOrder) {

@@ -19,6 +19,7 @@
 #include "common/util/time.hpp"
 #include "procman/testbed.hpp"
 #include "tests/support/test_support.hpp"
+#include "tools/latency/stats.hpp"
 #include "tools/link/link_model.hpp"
 #include "tools/link/probe.hpp"
 
@@ -30,13 +31,6 @@ namespace {
 
 const std::string kAir = "udpm://239.255.76.67:7667?ttl=0";
 const std::string kGround = "udpm://239.255.76.68:7668?ttl=0";
-
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const size_t k = static_cast<size_t>(pos);
-  return v[k] + (pos - static_cast<double>(k)) * (v[std::min(k + 1, v.size() - 1)] - v[k]);
-}
 
 class LinkNode : public ::testing::Test {
  protected:
@@ -92,9 +86,9 @@ air_to_ground: {channels: "PROBE", delay_ms: 20, jitter_ms: 5, jitter_distributi
   const auto d = probe.delays_ms();
   ASSERT_EQ(d.size(), 1000u) << link_->log();
   // Normal(20, 5): quantiles 20 -/+ 1.2816 * 5 at 10 % / 90 %.
-  EXPECT_NEAR(quantile(d, 0.10), 20.0 - 1.2816 * 5, 2.0);
-  EXPECT_NEAR(quantile(d, 0.50), 20.0, 2.0);
-  EXPECT_NEAR(quantile(d, 0.90), 20.0 + 1.2816 * 5, 2.0);
+  EXPECT_NEAR(latency::percentile(d, 0.10), 20.0 - 1.2816 * 5, 2.0);
+  EXPECT_NEAR(latency::percentile(d, 0.50), 20.0, 2.0);
+  EXPECT_NEAR(latency::percentile(d, 0.90), 20.0 + 1.2816 * 5, 2.0);
   EXPECT_NEAR(std::accumulate(d.begin(), d.end(), 0.0) / static_cast<double>(d.size()), 20.0, 2.0);
 }
 
@@ -109,8 +103,8 @@ air_to_ground: {channels: "PROBE", delay_ms: 50}
   const auto d = probe.delays_ms();
   ASSERT_EQ(d.size(), 200u);
   EXPECT_GE(*std::min_element(d.begin(), d.end()), 50.0);
-  EXPECT_NEAR(quantile(d, 0.5), 50.0, 2.0);
-  EXPECT_NEAR(quantile(d, 0.9), 50.0, 2.0);
+  EXPECT_NEAR(latency::percentile(d, 0.5), 50.0, 2.0);
+  EXPECT_NEAR(latency::percentile(d, 0.9), 50.0, 2.0);
 }
 
 TEST_F(LinkNode, LossRateWithinOnePointOver10000Messages) {
