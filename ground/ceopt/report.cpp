@@ -33,7 +33,7 @@ std::string g(double v) {
 
 class Writer {
  public:
-  Writer(const fs::path& path, std::vector<std::string>& written) : path_(path), out_(path) {
+  Writer(const fs::path& path, std::vector<std::string>& written) : out_(path) {
     if (!out_) throw std::runtime_error(path.string() + ": cannot write");
     written.push_back(path.string());
   }
@@ -42,10 +42,8 @@ class Writer {
     out_ << v;
     return *this;
   }
-  ~Writer() { out_.flush(); }
 
  private:
-  fs::path path_;
   std::ofstream out_;
 };
 
@@ -216,7 +214,8 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
           if (s.controller == "sf") thesis = f(th.sf, 2);
           if (s.controller == "sfmf") thesis = f(th.sfmf, 2);
         }
-      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << f(s.rmse_mean, 2) << " ± " << f(s.rmse_std, 2) << " | "
+      const std::string rmse = s.settled ? f(s.rmse_mean, 2) + " ± " + f(s.rmse_std, 2) : "never settled";
+      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << rmse << " | "
         << thesis << " | " << f(s.min_wall_distance, 2) << " | " << s.entered_dangerous << "/" << s.runs << " | " << s.collided
         << " | " << s.settled << "/" << s.runs << " |\n";
     }
