@@ -30,6 +30,9 @@ int main(int argc, char** argv) {
   std::string vehicle = "ardrone";
   double rate_hz = 30.0, duration_s = 0.0, start_y = 1.0;
   int substeps = 10;
+  std::string pose_channel = channels::kGtPose, command_channel = channels::kCtrlCmd;
+  app.add_option("--pose-channel", pose_channel, "channel for the vehicle's aerie.gt_pose_t (another name keeps it apart from a scene simulator's GT_POSE)");
+  app.add_option("--command-channel", command_channel, "channel of the aerie.control_cmd_t commands");
   app.add_option("--vehicle", vehicle, "ardrone or pelican (or scenario.vehicle of --config, a ceopt-style YAML)");
   app.add_option("--rate", rate_hz, "GT_POSE rate (Hz)");
   app.add_option("--duration", duration_s, "stop after this simulated time (s); 0 = until Ctrl-C");
@@ -53,7 +56,7 @@ int main(int argc, char** argv) {
     bus::StatusReporter status(bus, "control-sim");
     aerie::control_cmd_t cmd{};
     cmd.mode = aerie::control_cmd_t::HOVER;
-    bus.subscribe<aerie::control_cmd_t>(channels::kCtrlCmd, [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) {
+    bus.subscribe<aerie::control_cmd_t>(command_channel, [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) {
       if (!std::isfinite(m.yaw_rate_deg_s) || !std::isfinite(m.velocity_body[0])) {
         status.count("bad_commands");
         return;
@@ -100,7 +103,7 @@ int main(int argc, char** argv) {
           p.orientation[1] = q.x();
           p.orientation[2] = q.y();
           p.orientation[3] = q.z();
-          bus.publish(channels::kGtPose, p);
+          bus.publish(pose_channel, p);
           status.set("min_wall_distance_mm", std::llround((scen.scene.wall_y_m - max_y) * 1000));
           status.set("heading_mdeg", std::llround(st.heading_deg * 1000));
         }

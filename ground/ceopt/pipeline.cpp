@@ -1,5 +1,7 @@
 #include "ground/ceopt/pipeline.hpp"
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -11,6 +13,12 @@
 
 namespace aerie::ceopt {
 namespace {
+
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 std::vector<CeParameter> parameters_from(const util::Config& cfg, const std::string& key, std::vector<CeParameter> fallback) {
   if (!cfg.has(key)) return fallback;
@@ -112,11 +120,13 @@ StageResult run_stage(int stage, const flc::FlcSpec& base, const std::vector<CeP
   CeOptions opt = cfg.ce;
   opt.seed = cfg.ce.seed + static_cast<uint64_t>(stage - 1);
   const util::Stopwatch watch;
+  const double cpu0 = process_cpu_seconds();
   r.ce = cross_entropy(
       parameters, opt, [&](const std::vector<double>& x) { return problem.cost(x); }, pool,
       [&](std::vector<double>& x) { problem.repair(x); },
       [&](const CeIteration& it) { return cb ? cb(stage, r.names, it) : true; });
   r.seconds = watch.ms() / 1000.0;
+  r.cpu_seconds = process_cpu_seconds() - cpu0;
   r.controller = problem.controller(r.ce.best);
   r.controller.id = stage == 1 ? "ce-sf" : "ce-sfmf";
   return r;

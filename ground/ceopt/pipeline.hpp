@@ -46,6 +46,7 @@ struct StageResult {
   CeResult ce;
   flc::FlcSpec controller;            // the base with the winner's parameters
   double seconds = 0.0;               // wall-clock time of the stage
+  double cpu_seconds = 0.0;           // CPU time of the process over the stage (all threads)
 };
 
 // One variable's merge of overlapping sets, tried on the training runs.

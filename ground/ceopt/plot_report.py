@@ -83,7 +83,7 @@ def plot_pdfs(out, stage):
         ax.set_title(f"{name}: mean {mu[-1]:.4g}, sigma {sg[-1]:.2g}", fontsize=9)
     fig.suptitle(f"Stage {stage}: evolution of the sampling PDF of each parameter")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, f"pdf_stage{stage}.png"), dpi=100)
+    fig.savefig(os.path.join(out, f"pdf_stage{stage}.png"), dpi=75)
     plt.close(fig)
 
 
@@ -114,7 +114,7 @@ def plot_mfs(out):
             ax.set_title(f"{c}: {v}", fontsize=9)
     fig.suptitle("Membership functions (scaled units; output sets as their peaks)")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "mfs.png"), dpi=100)
+    fig.savefig(os.path.join(out, "mfs.png"), dpi=80)
     plt.close(fig)
 
 

@@ -33,7 +33,7 @@ std::string g(double v) {
 
 class Writer {
  public:
-  Writer(const fs::path& path, std::vector<std::string>& written) : path_(path), out_(path) {
+  Writer(const fs::path& path, std::vector<std::string>& written) : out_(path) {
     if (!out_) throw std::runtime_error(path.string() + ": cannot write");
     written.push_back(path.string());
   }
@@ -42,10 +42,8 @@ class Writer {
     out_ << v;
     return *this;
   }
-  ~Writer() { out_.flush(); }
 
  private:
-  fs::path path_;
   std::ofstream out_;
 };
 
@@ -148,6 +146,7 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
     for (const StageResult* st : {&t.stage1, &t.stage2}) {
       if (st->ce.history.empty()) continue;
       w << (first ? "" : ",") << "\n    {\"stage\": " << st->stage << ", \"seconds\": " << g(st->seconds)
+        << ", \"cpu_seconds\": " << g(st->cpu_seconds)
         << ", \"iterations\": " << st->ce.history.size() << ", \"evaluations\": " << st->ce.evaluations
         << ", \"best_cost\": " << g(st->ce.best_cost) << ", \"winner_iteration\": " << st->ce.best_iteration
         << ", \"stop_reason\": \"" << st->ce.stop_reason << "\", \"best\": {";
@@ -180,12 +179,12 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
       << ", beta = " << cfg.ce.beta << ", q = " << cfg.ce.q << "; each candidate flies "
       << cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed)
       << " training runs (cost: mean ITSE + penalties).\n\n"
-      << "| stage | parameters | iterations | evaluations | time (s) | best cost | winner iteration | best values |\n"
-      << "|---|---|---|---|---|---|---|---|\n";
+      << "| stage | parameters | iterations | evaluations | wall time (s) | CPU time (s) | best cost | winner iteration | best values |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
     for (const StageResult* st : {&t.stage1, &t.stage2}) {
       if (st->ce.history.empty()) continue;
       w << "| " << st->stage << " | " << st->names.size() << " | " << st->ce.history.size() << " | " << st->ce.evaluations << " | "
-        << f(st->seconds, 1) << " | " << f(st->ce.best_cost, 1) << " | " << st->ce.best_iteration << " | ";
+        << f(st->seconds, 1) << " | " << f(st->cpu_seconds, 1) << " | " << f(st->ce.best_cost, 1) << " | " << st->ce.best_iteration << " | ";
       for (size_t j = 0; j < st->names.size(); ++j) w << (j ? ", " : "") << st->names[j] << " = " << f(st->ce.best[j], 4);
       w << " |\n";
     }
@@ -215,7 +214,8 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
           if (s.controller == "sf") thesis = f(th.sf, 2);
           if (s.controller == "sfmf") thesis = f(th.sfmf, 2);
         }
-      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << f(s.rmse_mean, 2) << " ± " << f(s.rmse_std, 2) << " | "
+      const std::string rmse = s.settled ? f(s.rmse_mean, 2) + " ± " + f(s.rmse_std, 2) : "never settled";
+      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << rmse << " | "
         << thesis << " | " << f(s.min_wall_distance, 2) << " | " << s.entered_dangerous << "/" << s.runs << " | " << s.collided
         << " | " << s.settled << "/" << s.runs << " |\n";
     }
