@@ -140,7 +140,10 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
     w << "{\n  \"command\": \"" << in.command_line << "\",\n  \"threads\": " << in.threads << ",\n  \"loadavg_before\": \""
       << in.load_before << "\",\n  \"loadavg_after\": \"" << in.load_after << "\",\n  \"samples\": " << cfg.ce.samples
       << ",\n  \"elite\": " << cfg.ce.elite << ",\n  \"runs_per_evaluation\": "
-      << cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed) << ",\n  \"stages\": [";
+      << cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed) << ",\n  \"scene\": {\"normal_area_m\": "
+      << g(cfg.training.scenario.scene.normal_area_m) << ", \"safe_area_m\": " << g(cfg.training.scenario.scene.safe_area_m)
+      << ", \"wall_m\": " << g(cfg.training.scenario.scene.wall_y_m) << ", \"lateral_limit_m\": "
+      << g(cfg.training.scenario.scene.lateral_limit_m) << "},\n  \"stages\": [";
     bool first = true;
     for (const StageResult* st : {&t.stage1, &t.stage2}) {
       if (st->ce.history.empty()) continue;
@@ -154,7 +157,7 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
     }
     w << "\n  ],\n  \"prune\": {\"rules_before\": " << t.prune_report.rules_before << ", \"rules_after\": " << t.prune_report.rules_after
       << ", \"sets_before\": " << t.prune_report.sets_before << ", \"sets_after\": " << t.prune_report.sets_after
-      << ", \"removed\": [";
+      << ", \"max_cost_increase\": " << g(cfg.prune_max_cost_increase) << ", \"removed\": [";
     for (size_t k = 0; k < t.prune_report.removed_sets.size(); ++k)
       w << (k ? ", " : "") << "\"" << t.prune_report.removed_sets[k] << "\"";
     w << "]},\n  \"experiment\": [";
@@ -190,6 +193,16 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
       << t.prune_report.rules_after << ", sets " << t.prune_report.sets_before << " -> " << t.prune_report.sets_after << "; removed: ";
     for (size_t k = 0; k < t.prune_report.removed_sets.size(); ++k) w << (k ? ", " : "") << "`" << t.prune_report.removed_sets[k] << "`";
     w << (t.prune_report.removed_sets.empty() ? "none" : "") << ".\n\n";
+    if (!t.prune_steps.empty()) {
+      w << "| merge tried | training cost before | after | kept (limit +" << f(100 * cfg.prune_max_cost_increase, 0)
+        << " % of the unpruned cost) |\n|---|---|---|---|\n";
+      for (const auto& st : t.prune_steps) {
+        w << "| ";
+        for (size_t k = 0; k < st.merges.size(); ++k) w << (k ? ", " : "") << "`" << st.merges[k] << "`";
+        w << " | " << f(st.cost_before, 1) << " | " << f(st.cost_after, 1) << " | " << (st.accepted ? "yes" : "no") << " |\n";
+      }
+      w << "\n";
+    }
     w << "## Avoidance experiment (" << cfg.evaluation.runs_per_speed << " runs per case, sensor noise "
       << cfg.training.scenario.sensor.noise_std_deg << " deg, latency " << cfg.training.scenario.sensor.delay_s
       << " s, safe avoiding area " << cfg.training.scenario.scene.safe_area_m << " m)\n\n"

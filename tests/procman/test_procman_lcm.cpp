@@ -109,6 +109,7 @@ TEST_F(ProcmanLcm, ObserverWatchesAndDeputyExitLeavesNothingRunning) {
                            (dir_ / "sheriff.log").string());
   ASSERT_EQ(sheriff.wait(60s).value_or(-1), 0) << sheriff.log();
   // The sheriff is gone; the command keeps running. An observer sees it.
+  for (int i = 0; i < 500 && (read_pid(pidfile) == 0 || read_pid(childfile) == 0); ++i) std::this_thread::sleep_for(10ms);
   const pid_t leader = read_pid(pidfile);
   ASSERT_TRUE(alive(leader));
   ASSERT_TRUE(alive(read_pid(childfile)));
@@ -125,6 +126,29 @@ TEST_F(ProcmanLcm, ObserverWatchesAndDeputyExitLeavesNothingRunning) {
   EXPECT_FALSE(alive(leader));
   const pid_t child = read_pid(childfile);
   EXPECT_GT(child, 0);
+  EXPECT_FALSE(alive(child));
+}
+
+TEST_F(ProcmanLcm, CommandsDieWithAKilledDeputy) {
+  // Even SIGKILL (no clean-up possible): the command dies with its deputy
+  // (PR_SET_PDEATHSIG) and its children with their terminal's session (SIGHUP).
+  const std::string pidfile = (dir_ / "leader.pid").string(), childfile = (dir_ / "child.pid").string();
+  const std::string cfg = write_config("cmd \"c\" { exec = \"sh -c 'echo $$ > " + pidfile + "; sleep 1000 & echo $! > " +
+                                       childfile + "; wait'\"; host = \"h1\"; }\n"
+                                       "script \"start\" { start everything wait \"running\"; }\n");
+  auto dep = deputy("h1", "deputy.log");
+  testbed::Process sheriff(in(*ns_, {bin("aerie-sheriff"), cfg, "--script", "start", "--on-script-complete", "exit",
+                                     "--wait-timeout", "30", "--no-table", "--lcm-url", kUrl}),
+                           (dir_ / "sheriff.log").string());
+  ASSERT_EQ(sheriff.wait(60s).value_or(-1), 0) << sheriff.log();
+  for (int i = 0; i < 500 && (read_pid(pidfile) == 0 || read_pid(childfile) == 0); ++i) std::this_thread::sleep_for(10ms);
+  const pid_t leader = read_pid(pidfile), child = read_pid(childfile);
+  ASSERT_TRUE(alive(leader));
+  ASSERT_TRUE(alive(child));
+  dep->stop(SIGKILL, 5s);
+  const auto until = std::chrono::steady_clock::now() + 5s;
+  while ((alive(leader) || alive(child)) && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(20ms);
+  EXPECT_FALSE(alive(leader));
   EXPECT_FALSE(alive(child));
 }
 

@@ -165,8 +165,12 @@ AxisRmse per_axis_rmse(const Trajectory& ref, const Trajectory& aligned_est) {
   for (size_t i = 0; i < ref.size(); ++i) {
     const Eigen::Vector3d dp = aligned_est.poses[i].translation() - ref.poses[i].translation();
     out.position += dp.cwiseAbs2();
-    const Eigen::Vector3d rpy =
-        roll_pitch_yaw(ref.poses[i].rotation_matrix().transpose() * aligned_est.poses[i].rotation_matrix());
+    // Orientation relative to each trajectory's first pose: a position-only alignment leaves
+    // the rotation about a straight path undetermined, the change since the start does not.
+    const Eigen::Matrix3d Rr = ref.poses[0].rotation_matrix().transpose() * ref.poses[i].rotation_matrix();
+    const Eigen::Matrix3d Re =
+        aligned_est.poses[0].rotation_matrix().transpose() * aligned_est.poses[i].rotation_matrix();
+    const Eigen::Vector3d rpy = roll_pitch_yaw(Rr.transpose() * Re);
     out.rpy_deg += (rpy * kRadToDeg).cwiseAbs2();
   }
   const double n = static_cast<double>(ref.size());

@@ -54,7 +54,8 @@ RelativeErrors rpe_frames(const Trajectory& ref, const Trajectory& est, size_t d
 // evo's delta in metres: consecutive pairs whose estimated path length between them reaches delta_m.
 RelativeErrors rpe_path(const Trajectory& ref, const Trajectory& est, double delta_m);
 
-// Per-axis RMSE of position (metres) and orientation (roll, pitch, yaw of R_ref^T R_est in degrees).
+// Per-axis RMSE of position (metres, of the aligned estimate) and orientation (roll, pitch, yaw in
+// degrees of the error between the rotations since the first pose, R_ref0^T R_ref vs R_est0^T R_est).
 struct AxisRmse {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d rpy_deg = Eigen::Vector3d::Zero();

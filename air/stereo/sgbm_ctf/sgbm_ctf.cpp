@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "common/util/time.hpp"
+#include "air/stereo/cpu_time.hpp"
 
 namespace aerie::stereo {
 namespace {
@@ -61,7 +61,16 @@ cv::Mat CoarseToFineSgbm::compute(const cv::Mat& left, const cv::Mat& right) {
   if (left.empty() || left.size() != right.size() || left.type() != CV_8UC1 || right.type() != CV_8UC1)
     throw std::invalid_argument("SGBM_F: left and right must be 8-bit gray images of the same size");
   timings_ = {};
-  util::Stopwatch sw;
+  CpuStopwatch sw;
+  const int W = params_.fine_window, D = params_.sgm.num_disparities;
+  if (2 * W >= D) {
+    // A window of half the range or more saves less than the coarse pass costs: plain SGM.
+    cv::Mat disparity = fine_matcher_.compute(left, right);
+    timings_.fine_ms = sw.ms();
+    coarse_ = cv::Mat();
+    coarse_density_ = 0;
+    return disparity;
+  }
   // Half resolution by area averaging (a 2x2 box, no aliasing of the census patterns).
   const cv::Size half((left.cols + 1) / 2, (left.rows + 1) / 2);
   cv::resize(left, left_half_, half, 0, 0, cv::INTER_AREA);
@@ -82,7 +91,6 @@ cv::Mat CoarseToFineSgbm::compute(const cv::Mat& left, const cv::Mat& right) {
   cv::Mat lo, hi;
   cv::erode(filled, lo, cv::Mat());
   cv::dilate(filled, hi, cv::Mat());
-  const int W = params_.fine_window, D = params_.sgm.num_disparities;
   offsets_.create(left.size(), CV_16SC1);
   for (int y = 0; y < left.rows; ++y) {
     const int cy = std::min(y / 2, filled.rows - 1);

@@ -5,6 +5,8 @@
 // then searches only a window of `fine_window` disparities centred on twice the
 // upsampled prior. The saving over full-range SGM follows eq. 4.3,
 // gamma = 1 - t_C / t_S ~= eta (D - 9) / D - 1/8, with our fixed window in place of 9.
+// When the window is half the range or more (small D) the coarse pass cannot pay for
+// itself and plain full-range SGM runs instead.
 #include <opencv2/core.hpp>
 
 #include "air/stereo/sgbm_ctf/sgm.hpp"

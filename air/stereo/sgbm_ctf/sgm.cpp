@@ -8,13 +8,11 @@
 #include <stdexcept>
 
 #include "air/stereo/sgbm_ctf/sgm_kernels.hpp"
-#include "common/util/time.hpp"
+#include "air/stereo/cpu_time.hpp"
 
 namespace aerie::stereo {
 namespace {
 
-constexpr int kDirs8[4][2] = {{1, 0}, {1, 1}, {0, 1}, {-1, 1}};
-constexpr int kDirs4[2][2] = {{1, 0}, {0, 1}};
 
 int census_bits(const SgmParams& p) { return p.census_width * p.census_height - 1; }
 
@@ -80,7 +78,7 @@ cv::Mat SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, co
   //    right image is mirrored (census of the flipped image with mirrored neighbours) so that
   //    the costs of consecutive disparities are contiguous; its D + 32 bytes of margin stand
   //    for the pixels left of the right image.
-  util::Stopwatch sw;
+  CpuStopwatch sw;
   const ptrdiff_t cstep = width + D + 2 * kernels::kWindowStep;
   census_left_.assign(static_cast<size_t>(cstep) * height * nplanes, 0);
   census_right_.assign(census_left_.size(), 0);
@@ -112,12 +110,11 @@ cv::Mat SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, co
   // 3. Aggregation along 4 or 8 paths: one forward and one backward sweep.
   sw.reset();
   sum_.resize(npix * window);
-  const int ndirs = params_.paths / 2;
-  scratch_.resize(kernels::pass_scratch_size(width, window, ndirs));
-  const int(*dirs)[2] = params_.paths == 8 ? kDirs8 : kDirs4;
+  scratch_.resize(kernels::pass_scratch_size(width, window, params_.paths));
   for (bool forward : {true, false}) {
-    kernels::PassArgs pa{cost_.data(), offsets.ptr<int16_t>(), sum_.data(), width, height, window, forward, ndirs,
-                         dirs, static_cast<uint16_t>(params_.p1), static_cast<uint16_t>(params_.p2), scratch_.data()};
+    kernels::PassArgs pa{cost_.data(), offsets.ptr<int16_t>(), sum_.data(), width, height, window, forward,
+                         params_.paths, static_cast<uint16_t>(params_.p1), static_cast<uint16_t>(params_.p2),
+                         scratch_.data()};
     kernels::aggregate_pass(pa);
   }
   timings_.aggregate_ms = sw.ms();

@@ -20,7 +20,7 @@ struct SgmParams {
   int p2 = 96;                // penalty of a larger change (P2 > P1)
   int census_width = 7;       // census window (odd sizes; width * height - 1 <= 64 bits)
   int census_height = 5;
-  int paths = 8;              // 4 (horizontal + vertical) or 8 (+ diagonals)
+  int paths = 4;              // 4 (horizontal + vertical) or 8 (+ diagonals)
   int uniqueness_percent = 10;  // a second minimum within this % of the best invalidates (0 = off)
   int lr_max_diff = 1;        // left-right consistency tolerance in pixels (< 0 = off)
   bool subpixel = true;       // parabola through the aggregated costs around the winner

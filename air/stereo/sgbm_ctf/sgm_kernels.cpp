@@ -102,19 +102,29 @@ PassLayout Layout(int width, int window) {
   return {stride, static_cast<size_t>(kPad) + static_cast<size_t>(width) * stride};
 }
 
-void AggregatePass(const PassArgs& a) {
+// Path directions (ax, ay): the previous pixel on path k is (x - s ax, y - s ay) with
+// s = +1 in the forward sweep and -1 in the backward one. Path 0 runs along the row.
+constexpr int kDirX[4] = {1, 1, 0, -1};
+constexpr int kDirY[4] = {0, 1, 1, 1};
+constexpr int kDirX4[2] = {1, 0};
+constexpr int kDirY4[2] = {0, 1};
+
+template <int kDirs, bool kOneChunk>
+void Pass(const PassArgs& a) {
   const hn::CappedTag<uint16_t, kWindowStep> d;
   const hn::Rebind<uint8_t, decltype(d)> d8;
   const int n = static_cast<int>(hn::Lanes(d));
   const int W = a.window, width = a.width;
   const PassLayout lay = Layout(width, W);
+  const int* dir_x = kDirs == 4 ? kDirX : kDirX4;
+  const int* dir_y = kDirs == 4 ? kDirY : kDirY4;
 
   // Scratch: per direction two path row buffers (previous, current) and their minima,
   // then a zero block (path start) and an all-unknown block (previous window too far).
   uint16_t* s = a.scratch;
-  uint16_t* L[2][4];
-  uint16_t* M[2][4];
-  for (int k = 0; k < a.ndirs; ++k) {
+  uint16_t* L[2][kDirs];
+  uint16_t* M[2][kDirs];
+  for (int k = 0; k < kDirs; ++k) {
     for (int b = 0; b < 2; ++b) {
       L[b][k] = s;
       std::fill(s, s + lay.rowlen, kUnknown);
@@ -131,52 +141,50 @@ void AggregatePass(const PassArgs& a) {
 
   const int sgn = a.forward ? 1 : -1;
   const auto vp1 = hn::Set(d, a.p1);
-  const bool one_chunk = n == W;  // the usual fine-level case: keep the sum in a register
   int cur = 1, prv = 0;
   for (int yi = 0; yi < a.height; ++yi) {
     const int y = a.forward ? yi : a.height - 1 - yi;
     // Per direction: the previous pixel's row (offsets, path buffer, minima) or none.
-    const int16_t* prow_off[4];
-    const uint16_t* prow_L[4];
-    const uint16_t* prow_M[4];
-    int step_x[4];
-    for (int k = 0; k < a.ndirs; ++k) {
-      const int py = y - sgn * a.dirs[k][1];
+    const int16_t* prow_off[kDirs];
+    const uint16_t* prow_L[kDirs];
+    const uint16_t* prow_M[kDirs];
+    uint16_t* out_L[kDirs];
+    for (int k = 0; k < kDirs; ++k) {
+      const int py = y - sgn * dir_y[k];
       const int b = py == y ? cur : prv;
       prow_off[k] = py >= 0 && py < a.height ? a.offsets + static_cast<ptrdiff_t>(py) * width : nullptr;
       prow_L[k] = L[b][k] + kPad;
       prow_M[k] = M[b][k];
-      step_x[k] = sgn * a.dirs[k][0];
+      out_L[k] = L[cur][k] + kPad;
     }
     const int16_t* orow = a.offsets + static_cast<ptrdiff_t>(y) * width;
-    uint16_t row_min = 0;
+    const uint8_t* crow = a.cost + static_cast<ptrdiff_t>(y) * width * W;
+    uint16_t* srow = a.sum + static_cast<ptrdiff_t>(y) * width * W;
+    uint16_t row_min = 0;  // path 0 keeps its minimum in a register (sequential dependency)
     for (int xi = 0; xi < width; ++xi) {
       const int x = a.forward ? xi : width - 1 - xi;
-      const ptrdiff_t pix = static_cast<ptrdiff_t>(y) * width + x;
       const int o = orow[x];
-      const uint8_t* c = a.cost + pix * W;
-      uint16_t* S = a.sum + pix * W;
+      const uint8_t* c = crow + static_cast<ptrdiff_t>(x) * W;
+      uint16_t* S = srow + static_cast<ptrdiff_t>(x) * W;
       auto acc = a.forward ? hn::Zero(d) : hn::LoadU(d, S);
-      for (int k = 0; k < a.ndirs; ++k) {
-        const int px = x - step_x[k];
+      for (int k = 0; k < kDirs; ++k) {
+        const int px = x - sgn * dir_x[k];
         const uint16_t* prev = zero;
         uint16_t minp = 0;
-        if (prow_off[k] && px >= 0 && px < width) {
+        if (prow_off[k] && static_cast<unsigned>(px) < static_cast<unsigned>(width)) {
           const int delta = o - prow_off[k][px];
           if (delta >= kPad || delta <= -kPad) {
             prev = unknown;  // no disparity in common: L = C + P2
           } else {
             prev = prow_L[k] + static_cast<ptrdiff_t>(px) * lay.stride + delta;
-            // The along-the-row path (k = 0) keeps its minimum in a register: no store/reload
-            // on the sequential dependency from one pixel to the next.
             minp = k == 0 ? row_min : prow_M[k][px];
           }
         }
         const auto vminp = hn::Set(d, minp);
         const auto vjump = hn::Set(d, static_cast<uint16_t>(minp + a.p2));
-        uint16_t* out = L[cur][k] + kPad + static_cast<ptrdiff_t>(x) * lay.stride;
+        uint16_t* out = out_L[k] + static_cast<ptrdiff_t>(x) * lay.stride;
         auto vmin = hn::Set(d, kUnknown);
-        for (int k0 = 0; k0 < W; k0 += n) {
+        for (int k0 = 0; k0 < (kOneChunk ? 1 : W); k0 += n) {
           const auto same = hn::LoadU(d, prev + k0);
           const auto below = hn::LoadU(d, prev + k0 - 1);
           const auto above = hn::LoadU(d, prev + k0 + 1);
@@ -186,7 +194,7 @@ void AggregatePass(const PassArgs& a) {
           const auto l = hn::Sub(hn::Add(cost, t), vminp);
           hn::StoreU(l, d, out + k0);
           vmin = hn::Min(vmin, l);
-          if (one_chunk) {
+          if (kOneChunk) {
             acc = hn::Add(acc, l);
           } else if (k == 0 && a.forward) {
             hn::StoreU(l, d, S + k0);
@@ -200,10 +208,19 @@ void AggregatePass(const PassArgs& a) {
         else
           M[cur][k][x] = m;
       }
-      if (one_chunk) hn::StoreU(acc, d, S);
+      if (kOneChunk) hn::StoreU(acc, d, S);
     }
     std::swap(cur, prv);
   }
+}
+
+void AggregatePass(const PassArgs& a) {
+  const hn::CappedTag<uint16_t, kWindowStep> d;
+  const bool one_chunk = static_cast<int>(hn::Lanes(d)) == a.window;  // the usual fine-level case
+  if (a.paths == 8)
+    one_chunk ? Pass<4, true>(a) : Pass<4, false>(a);
+  else
+    one_chunk ? Pass<2, true>(a) : Pass<2, false>(a);
 }
 
 void SelectRow(const SelectRowArgs& a) {
@@ -283,7 +300,8 @@ void cost_row(const CostRowArgs& a) { HWY_DYNAMIC_DISPATCH(CostRow)(a); }
 void aggregate_pass(const PassArgs& a) { HWY_DYNAMIC_DISPATCH(AggregatePass)(a); }
 void select_row(const SelectRowArgs& a) { HWY_DYNAMIC_DISPATCH(SelectRow)(a); }
 
-size_t pass_scratch_size(int width, int window, int ndirs) {
+size_t pass_scratch_size(int width, int window, int paths) {
+  const int ndirs = paths / 2;
   const size_t rowlen = static_cast<size_t>(kWindowStep) + static_cast<size_t>(width) * (window + kWindowStep);
   return static_cast<size_t>(ndirs) * 2 * (rowlen + width) + 2 * (window + 2);
 }

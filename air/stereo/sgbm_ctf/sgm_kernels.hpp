@@ -43,13 +43,11 @@ struct PassArgs {
   uint16_t* sum;           // [y][x][window]: written by the forward pass, added by the backward pass
   int width, height, window;
   bool forward;
-  int ndirs;
-  const int (*dirs)[2];    // (ax, ay): the previous pixel is (x - s ax, y - s ay), s = +1 forward, -1 backward;
-                           // dirs[0] must be (1, 0), the path along the row
+  int paths;               // 4 (along rows and columns) or 8 (and the diagonals)
   uint16_t p1, p2;
   uint16_t* scratch;        // pass_scratch_size() values
 };
-size_t pass_scratch_size(int width, int window, int ndirs);
+size_t pass_scratch_size(int width, int window, int paths);
 // Path costs L_r(p, d) = C(p, d) + min(L_r(p-r, d), L_r(p-r, d +- 1) + P1, min_k L_r(p-r, k) + P2)
 // - min_k L_r(p-r, k) (Hirschmueller 2008) over a restricted, per-pixel disparity window.
 void aggregate_pass(const PassArgs& a);
