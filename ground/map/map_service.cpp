@@ -141,11 +141,11 @@ void MapService::on_pose(const aerie::pose_t& msg, const bus::ReceiveInfo& info)
   while (poses_.size() > config_.pose_buffer) poses_.erase(poses_.begin());
   // Depth frames that were waiting for this pose.
   for (auto it = pending_.begin(); it != pending_.end();) {
-    if (std::llabs(it->utime - msg.utime) <= config_.pose_tolerance_us) {
+    if (std::llabs(it->first - msg.utime) <= config_.pose_tolerance_us) {
       status_.count("pose_from_vo");
-      const aerie::spherical_depth_t depth = *it;
+      const auto [utime, depth] = std::move(*it);
       it = pending_.erase(it);
-      insert(depth, *pose, info.recv_utime);
+      insert(depth, utime, *pose, info.recv_utime);
     } else {
       ++it;
     }
@@ -156,8 +156,9 @@ void MapService::on_pose(const aerie::pose_t& msg, const bus::ReceiveInfo& info)
 void MapService::on_depth(const aerie::spherical_depth_t& msg, const bus::ReceiveInfo& info) {
   status_.count("depth_frames");
   std::optional<geometry::SE3> own_pose;
+  spherical::SphericalDepth depth;
   try {
-    (void)spherical::from_message(msg);
+    depth = spherical::from_message(msg);
     own_pose = spherical::pose_of(msg);
   } catch (const std::invalid_argument& e) {
     reject("depth_malformed", config_.depth_channel + " seq " + std::to_string(msg.seq) + ": " + e.what() +
@@ -168,35 +169,35 @@ void MapService::on_depth(const aerie::spherical_depth_t& msg, const bus::Receiv
   if (msg.utime < last_depth_utime_) status_.count("depth_out_of_order");  // still mapped
   if (const auto vo = vo_pose_at(msg.utime)) {
     status_.count("pose_from_vo");
-    insert(msg, *vo, info.recv_utime);
+    insert(depth, msg.utime, *vo, info.recv_utime);
   } else if (own_pose) {
     status_.count("pose_from_depth");
-    insert(msg, *own_pose, info.recv_utime);
+    insert(depth, msg.utime, *own_pose, info.recv_utime);
   } else {
     status_.count("depth_waiting_for_pose");
-    pending_.push_back(msg);
+    pending_.push_back({msg.utime, std::move(depth)});
   }
   expire_pending();
 }
 
 void MapService::expire_pending() {
   while (!pending_.empty() &&
-         (pending_.front().utime + config_.pose_wait_us < newest_utime_ || pending_.size() > 100)) {
-    reject("depth_without_pose", config_.depth_channel + " utime " + std::to_string(pending_.front().utime) +
+         (pending_.front().first + config_.pose_wait_us < newest_utime_ || pending_.size() > 100)) {
+    reject("depth_without_pose", config_.depth_channel + " utime " + std::to_string(pending_.front().first) +
                                      " has no pose and no " + config_.pose_channel + " within " +
                                      seconds(config_.pose_wait_us) + "; dropped");
     pending_.pop_front();
   }
 }
 
-void MapService::insert(const aerie::spherical_depth_t& msg, const geometry::SE3& T_world_camera,
+void MapService::insert(const spherical::SphericalDepth& depth, int64_t utime, const geometry::SE3& T_world_camera,
                         int64_t receive_utime) {
   util::Stopwatch watch;
   FrameStats stats;
   try {
-    stats = map_.insert_depth(spherical::from_message(msg), T_world_camera);
+    stats = map_.insert_depth(depth, T_world_camera);
   } catch (const std::invalid_argument& e) {
-    reject("depth_rejected", config_.depth_channel + " utime " + std::to_string(msg.utime) + ": " + e.what());
+    reject("depth_rejected", config_.depth_channel + " utime " + std::to_string(utime) + ": " + e.what());
     return;
   }
   status_.time_ms("insert", watch.ms());
@@ -208,10 +209,10 @@ void MapService::insert(const aerie::spherical_depth_t& msg, const geometry::SE3
   status_.set("map_nodes", static_cast<int64_t>(map_.tree().size()));
   status_.set("map_bytes", static_cast<int64_t>(map_.memory_bytes()));
   merge(unpublished_, map_.take_changed_region());
-  last_depth_utime_ = std::max(last_depth_utime_, msg.utime);
+  last_depth_utime_ = std::max(last_depth_utime_, utime);
   status_.ok();
-  maybe_publish(msg.utime);
-  status_.mark_hop(msg.utime, receive_utime, util::wall_utime());
+  maybe_publish(utime);
+  status_.mark_hop(utime, receive_utime, util::wall_utime());
 }
 
 void MapService::maybe_publish(int64_t utime) {

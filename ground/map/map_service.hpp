@@ -69,7 +69,8 @@ class MapService {
   // False (and counted) when utime is too far ahead of the newest message seen.
   bool accept_time(int64_t utime, const char* what);
   std::optional<geometry::SE3> vo_pose_at(int64_t utime) const;
-  void insert(const aerie::spherical_depth_t& msg, const geometry::SE3& T_world_camera, int64_t receive_utime);
+  void insert(const spherical::SphericalDepth& depth, int64_t utime, const geometry::SE3& T_world_camera,
+              int64_t receive_utime);
   void expire_pending();
   void maybe_publish(int64_t utime);
   aerie::map_response_t answer(const aerie::map_query_t& q);
@@ -81,7 +82,7 @@ class MapService {
   OccupancyMap map_;
   DistanceMap distances_;
   std::map<int64_t, geometry::SE3> poses_;         // VO_POSE by utime
-  std::deque<aerie::spherical_depth_t> pending_;   // depth waiting for its VO_POSE
+  std::deque<std::pair<int64_t, spherical::SphericalDepth>> pending_;  // (utime, depth) waiting for VO_POSE
   int64_t newest_utime_ = -1;                      // newest accepted message time
   int64_t last_depth_utime_ = -1;
   int64_t last_publish_utime_ = -1;
