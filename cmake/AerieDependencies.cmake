@@ -23,7 +23,7 @@ if(AERIE_BUILD_VIEWER)
   # VTK 9.1 on Debian needs MPI found first (NOTES.md).
   find_package(MPI REQUIRED COMPONENTS C)
   find_package(VTK REQUIRED COMPONENTS CommonCore CommonDataModel FiltersSources FiltersCore
-               RenderingCore RenderingOpenGL2 RenderingFreeType RenderingContext2D
+               RenderingCore RenderingOpenGL2 RenderingFreeType RenderingAnnotation RenderingContext2D
                RenderingContextOpenGL2 InteractionStyle InteractionWidgets ChartsCore
                ViewsContext2D IOImage)
 endif()

@@ -29,6 +29,13 @@ void Subscription::note_seq(int64_t seq) {
   last_seq_ = seq;
 }
 
+std::optional<int64_t> peek_utime(const uint8_t* data, size_t size) {
+  if (size < 16) return std::nullopt;
+  uint64_t v = 0;
+  for (int i = 8; i < 16; ++i) v = (v << 8) | data[i];
+  return static_cast<int64_t>(v);
+}
+
 namespace {
 std::string resolve_url(const std::string& url) {
   if (!url.empty()) return url;

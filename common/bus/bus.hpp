@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -72,6 +73,24 @@ class TypedSubscription final : public Subscription {
   Handler handler_;
 };
 
+// Undecoded messages (any type), e.g. for relays, loggers and latency measurement.
+class RawSubscription final : public Subscription {
+ public:
+  using Handler = std::function<void(const uint8_t* data, size_t size, const ReceiveInfo&)>;
+  explicit RawSubscription(Handler h) : handler_(std::move(h)) {}
+
+ private:
+  void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
+    handler_(static_cast<const uint8_t*>(rbuf->data), rbuf->data_size,
+             ReceiveInfo{channel, rbuf->recv_utime, rbuf->data_size});
+  }
+  Handler handler_;
+};
+
+// The utime of an Aerie message without decoding it: every Aerie type starts with
+// `int64_t utime` right after the 8-byte fingerprint (big-endian). nullopt when too short.
+std::optional<int64_t> peek_utime(const uint8_t* data, size_t size);
+
 class Bus {
  public:
   // url "" = LCM_DEFAULT_URL or LCM's default. Throws std::runtime_error if LCM cannot start.
@@ -93,6 +112,12 @@ class Bus {
                           int queue_capacity = 30) {
     auto sub = std::make_unique<TypedSubscription<Msg>>(std::move(handler));
     return attach(std::move(sub), channel, queue_capacity);
+  }
+
+  // channel_regex is an LCM channel regular expression (e.g. "CAM_.*").
+  Subscription& subscribe_raw(const std::string& channel_regex, RawSubscription::Handler handler,
+                              int queue_capacity = 30) {
+    return attach(std::make_unique<RawSubscription>(std::move(handler)), channel_regex, queue_capacity);
   }
 
   // Handles messages for up to timeout_ms; returns how many were handled (0 on timeout).

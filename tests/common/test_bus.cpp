@@ -76,3 +76,22 @@ TEST(Bus, HandlerExceptionIsCountedAndStatusReportsIt) {
 TEST(Bus, BadUrlIsAClearError) {
   EXPECT_THROW(Bus("nosuchprovider://x"), std::runtime_error);
 }
+
+TEST(Bus, RawSubscriptionSeesAnyTypeAndPeeksUtime) {
+  Bus bus("memq://");
+  std::vector<std::pair<std::string, int64_t>> got;
+  bus.subscribe_raw("VO_.*", [&](const uint8_t* data, size_t size, const ReceiveInfo& info) {
+    got.emplace_back(info.channel, aerie::bus::peek_utime(data, size).value_or(-1));
+  });
+  aerie::pose_t p{};
+  p.utime = 1234567890123;
+  bus.publish("VO_POSE", p);
+  bus.publish("OTHER", p);
+  const uint8_t tiny[3] = {1, 2, 3};
+  bus.raw().publish("VO_X", tiny, 3);
+  while (bus.handle(0) > 0) {
+  }
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0], std::make_pair(std::string("VO_POSE"), int64_t{1234567890123}));
+  EXPECT_EQ(got[1].second, -1);
+}

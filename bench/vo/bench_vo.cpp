@@ -1,0 +1,212 @@
+// aerie-bench-vo: runs the stereo VO on a KITTI odometry folder, an EuRoC ASL folder or a
+// simulated flight, writes the trajectory (TUM) and scores it against the ground truth
+// (ATE after SE3 alignment, RPE per frame and over segments, per-axis RMSE, end-point
+// drift), with the thread CPU time of every stage.
+#include <CLI/CLI.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "air/stereo/cpu_time.hpp"
+#include "air/stereo/vo/vo_config.hpp"
+#include "common/sim/simulation.hpp"
+#include "common/util/time.hpp"
+#include "tools/eval/report.hpp"
+#include "tools/eval/stereo_dataset.hpp"
+
+namespace fs = std::filesystem;
+using namespace aerie;
+
+namespace {
+
+// A frame source: a dataset folder or the simulator.
+struct Source {
+  std::string name;
+  stereo::StereoCamera cam;
+  std::shared_ptr<eval::Trajectory> gt = std::make_shared<eval::Trajectory>();  // sim: filled as frames come
+  std::function<bool(size_t, cv::Mat&, cv::Mat&, int64_t&)> next;
+  size_t frames = 0;
+  double path_m = 0;  // ground-truth path length known in advance (sim), else 0
+};
+
+Source open_dataset(const std::string& spec) {
+  Source s;
+  const auto colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon), arg = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  if (kind == "sim") {
+    const util::Config cfg = arg.empty() ? util::Config() : util::Config::load(arg);
+    sim::WorldConfig wc;
+    wc.seed = cfg.get<uint64_t>("world.seed", wc.seed);
+    sim::RigConfig rig;
+    rig.width = cfg.get<int>("rig.width", rig.width);
+    rig.height = cfg.get<int>("rig.height", rig.height);
+    rig.noise_sigma = cfg.get<double>("rig.noise_sigma", 1.0);
+    rig.pitch_deg = cfg.get<double>("rig.pitch_deg", rig.pitch_deg);
+    rig.illumination_amplitude = cfg.get<double>("rig.illumination_amplitude", rig.illumination_amplitude);
+    const std::string traj = cfg.get<std::string>("trajectory.kind", "survey_loops");
+    const double speed = cfg.get<double>("trajectory.speed", 1.0);
+    const double rate = cfg.get<double>("rate_hz", 20.0);
+    auto world = std::make_shared<sim::World>(sim::World::room(wc));
+    sim::Trajectory t = traj == "demo_flight" ? sim::Trajectory::demo_flight(*world, speed)
+                        : traj == "survey_loops"
+                            ? sim::Trajectory::survey_loops(*world, cfg.get<int>("trajectory.loops", 1), speed)
+                            : throw std::runtime_error(arg + ": trajectory.kind must be survey_loops or demo_flight");
+    auto simulation = std::make_shared<sim::StereoSimulation>(*world, rig, t, rate);
+    const auto K = simulation->intrinsics();
+    s.cam = {K.fx, K.fy, K.cx, K.cy, K.baseline, K.width, K.height};
+    s.frames = static_cast<size_t>(simulation->frame_count());
+    s.path_m = t.length();
+    s.name = "sim " + traj + " " + std::to_string(rig.width) + "x" + std::to_string(rig.height);
+    s.next = [simulation, gt = s.gt](size_t, cv::Mat& l, cv::Mat& r, int64_t& utime) {
+      sim::StereoFrame f;
+      if (!simulation->next(f)) return false;
+      l = f.left;
+      r = f.right;
+      utime = f.utime;
+      gt->push_back(static_cast<double>(f.utime) * 1e-6, f.T_world_left);
+      return true;
+    };
+    return s;
+  }
+  std::shared_ptr<eval::StereoSequence> seq = eval::open_sequence(spec);
+  const auto& rig = seq->rig();
+  s.cam = {rig.fx, rig.fy, rig.cx, rig.cy, rig.baseline, rig.size.width, rig.size.height};
+  s.frames = seq->size();
+  *s.gt = seq->ground_truth();
+  s.name = kind + " " + seq->name();
+  s.next = [seq](size_t i, cv::Mat& l, cv::Mat& r, int64_t& utime) {
+    if (i >= seq->size()) return false;
+    seq->load(i, l, r);
+    utime = seq->utime(i);
+    return true;
+  };
+  return s;
+}
+
+struct Mean {
+  double sum = 0;
+  int n = 0;
+  void add(double v) {
+    sum += v;
+    ++n;
+  }
+  double value() const { return n ? sum / n : 0; }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Stereo VO evaluation on KITTI / EuRoC folders or a simulated flight"};
+  std::string dataset, config, out = "vo_trajectory.txt", json_path, plot;
+  size_t max_frames = 0;
+  double rpe_delta_m = 0;
+  bool ba_sync = true;
+  app.add_option("--dataset", dataset, "kitti:DIR, euroc:DIR or sim:CONFIG.yaml")->required();
+  app.add_option("-c,--config", config, "VO configuration (config/vo.yaml format)")->check(CLI::ExistingFile);
+  app.add_option("--out", out, "trajectory output (TUM: t x y z qx qy qz qw)");
+  app.add_option("--json", json_path, "results as JSON");
+  app.add_option("--plot", plot, "PNG of the trajectory and its errors (needs /usr/bin/python3 + matplotlib)");
+  app.add_option("--max-frames", max_frames, "stop after this many frames (0 = all)");
+  app.add_option("--rpe-delta-m", rpe_delta_m, "also RPE over path segments of this length (m)");
+  app.add_option("--ba-sync", ba_sync, "wait for each bundle adjustment (reproducible figures; false = as flown)");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    stereo::VoParams params =
+        config.empty() ? stereo::VoParams{} : stereo::vo_params_from_config(util::Config::load(config), {"node"});
+    params.ba_synchronous = ba_sync;
+    Source src = open_dataset(dataset);
+    stereo::StereoOdometry vo(src.cam, params);
+    std::cout << src.name << ": " << src.frames << " frames " << src.cam.width << "x" << src.cam.height
+              << ", f " << src.cam.fx << " px, baseline " << src.cam.baseline << " m, SGM SIMD "
+              << stereo::SemiGlobalMatcher::simd_target() << "\n";
+
+    eval::Trajectory est;
+    Mean depth, features, matching, motion, book, total, total_nodepth, wall;
+    int lost = 0, keyframes = 0, ba_applied = 0;
+    double inlier_ratio = 0;
+    int64_t utime = 0;
+    cv::Mat l, r;
+    for (size_t i = 0; (max_frames == 0 || i < max_frames) && src.next(i, l, r, utime); ++i) {
+      util::Stopwatch sw;
+      const stereo::VoResult res = vo.process(l, r, utime);
+      wall.add(sw.ms());
+      est.push_back(static_cast<double>(utime) * 1e-6, res.T_world_cam);
+      const auto& t = res.timings;
+      depth.add(t.depth);
+      features.add(t.features);
+      matching.add(t.matching);
+      motion.add(t.motion);
+      book.add(t.bookkeeping);
+      total.add(t.total());
+      if (!res.depth_computed) total_nodepth.add(t.total());
+      lost += res.status == stereo::VoStatus::Lost;
+      keyframes += res.keyframe;
+      ba_applied += res.ba_applied;
+      inlier_ratio += res.inlier_ratio;
+      if (res.status == stereo::VoStatus::Lost || res.status == stereo::VoStatus::Reset)
+        std::cout << "frame " << res.frame << ": " << stereo::to_string(res.status) << " - " << res.message << "\n";
+    }
+    vo.flush();
+    eval::write_tum(est, out);
+    const int n = static_cast<int>(est.size());
+    std::cout << std::fixed << std::setprecision(2) << n << " frames, " << keyframes << " keyframes, " << lost
+              << " lost, mean inlier ratio " << inlier_ratio / std::max(1, n) << "\n"
+              << "CPU ms per frame: depth " << depth.value() << "  features " << features.value() << "  matching "
+              << matching.value() << "  motion " << motion.value() << "  other " << book.value() << "  = total "
+              << total.value() << " (" << 1000.0 / total.value() << " fps; frames without depth "
+              << total_nodepth.value() << " ms); wall " << wall.value() << " ms\n";
+
+    std::ostringstream js;
+    js << std::setprecision(8) << "{\"dataset\": \"" << src.name << "\", \"frames\": " << n
+       << ", \"width\": " << src.cam.width << ", \"height\": " << src.cam.height << ", \"keyframes\": " << keyframes
+       << ", \"lost\": " << lost << ", \"ba_synchronous\": " << (ba_sync ? "true" : "false")
+       << ", \"ms\": {\"depth\": " << depth.value() << ", \"features\": " << features.value()
+       << ", \"matching\": " << matching.value() << ", \"motion\": " << motion.value()
+       << ", \"other\": " << book.value() << ", \"total\": " << total.value()
+       << ", \"total_without_depth\": " << total_nodepth.value() << ", \"wall\": " << wall.value()
+       << "}, \"fps\": " << 1000.0 / total.value();
+    if (!src.gt->empty()) {
+      eval::ReportOptions ro;
+      ro.max_dt = 0.002;
+      ro.rpe_delta_m = rpe_delta_m;
+      const eval::Report rep = eval::evaluate(*src.gt, est, ro);
+      eval::print(std::cout, rep, ro);
+      js << ", \"metrics\": " << eval::to_json(rep, ro);
+      if (!plot.empty()) {
+        // Aligned estimate and ground truth for the plot script.
+        const auto a = eval::associate(*src.gt, est, ro.max_dt);
+        const auto aligned = eval::align(a.est, a.ref, eval::Alignment::SE3);
+        const fs::path csv = fs::path(plot).replace_extension(".csv");
+        std::ofstream c(csv);
+        c << "t,gx,gy,gz,ex,ey,ez\n" << std::setprecision(9);
+        for (size_t i = 0; i < a.ref.size(); ++i) {
+          const auto& g = a.ref.poses[i].translation();
+          const auto& e = aligned.poses[i].translation();
+          c << a.ref.stamps[i] << ',' << g.x() << ',' << g.y() << ',' << g.z() << ',' << e.x() << ',' << e.y() << ','
+            << e.z() << '\n';
+        }
+        c.close();
+        const fs::path script = fs::path(AERIE_BENCH_VO_DIR) / "plot_vo.py";
+        const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + csv.string() + "' '" + plot +
+                                "' '" + src.name + "'";
+        if (std::system(cmd.c_str()) != 0) std::cerr << "plot failed: " << cmd << "\n";
+      }
+    } else {
+      const eval::Drift d = eval::end_point_drift({}, est);
+      std::cout << "no ground truth; end point " << d.loop_closure_m << " m from the start\n";
+      js << ", \"end_point_m\": " << d.loop_closure_m;
+    }
+    js << "}\n";
+    if (!json_path.empty()) std::ofstream(json_path) << js.str();
+    std::cout << "trajectory: " << out << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "aerie-bench-vo: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

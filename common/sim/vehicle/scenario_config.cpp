@@ -1,0 +1,75 @@
+#include "common/sim/vehicle/scenario_config.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace aerie::sim {
+
+void require_known_keys(const util::Config& section, std::initializer_list<const char*> allowed) {
+  const YAML::Node& n = section.node();
+  if (!n || n.IsNull()) return;
+  if (!n.IsMap()) throw std::runtime_error(section.origin() + ": expected a map");
+  for (const auto& kv : n) {
+    const auto key = kv.first.as<std::string>();
+    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+      std::string list;
+      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+      throw std::runtime_error(section.origin() + ": unknown key '" + key + "' (expected one of: " + list + ")");
+    }
+  }
+}
+
+AvoidanceConfig avoidance_config_from(const util::Config& s, AvoidanceConfig c) {
+  require_known_keys(s, {"vehicle", "vehicle_params", "scene", "sensor", "camera", "gusts", "physics_substeps", "max_time_s",
+                         "settle_band_deg"});
+  try {
+    c.vehicle = VehicleParams::by_name(s.get<std::string>("vehicle", c.vehicle.name));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(s.origin() + ": 'vehicle': " + e.what());
+  }
+  const auto vp = s.section("vehicle_params");
+  require_known_keys(vp, {"yaw_time_constant_s", "max_yaw_rate_deg_s", "velocity_time_constant_s", "command_delay_s"});
+  c.vehicle.yaw_time_constant_s = vp.get("yaw_time_constant_s", c.vehicle.yaw_time_constant_s);
+  c.vehicle.max_yaw_rate_deg_s = vp.get("max_yaw_rate_deg_s", c.vehicle.max_yaw_rate_deg_s);
+  c.vehicle.velocity_time_constant_s = vp.get("velocity_time_constant_s", c.vehicle.velocity_time_constant_s);
+  c.vehicle.command_delay_s = vp.get("command_delay_s", c.vehicle.command_delay_s);
+
+  const auto scene = s.section("scene");
+  require_known_keys(scene, {"wall_m", "normal_area_m", "safe_area_m", "lateral_limit_m"});
+  c.scene.wall_y_m = scene.get("wall_m", c.scene.wall_y_m);
+  c.scene.normal_area_m = scene.get("normal_area_m", c.scene.normal_area_m);
+  c.scene.safe_area_m = scene.get("safe_area_m", c.scene.safe_area_m);
+  c.scene.lateral_limit_m = scene.get("lateral_limit_m", c.scene.lateral_limit_m);
+  if (!(c.scene.normal_area_m > 0 && c.scene.safe_area_m > 0 && c.scene.dangerous_from() < c.scene.wall_y_m))
+    throw std::runtime_error(scene.origin() + ": needs 0 < normal_area_m, 0 < safe_area_m and normal + safe < wall_m");
+
+  const auto sensor = s.section("sensor");
+  require_known_keys(sensor, {"rate_hz", "delay_s", "noise_std_deg", "drift_deg_per_sqrt_s"});
+  c.sensor.rate_hz = sensor.get("rate_hz", c.sensor.rate_hz);
+  c.sensor.delay_s = sensor.get("delay_s", c.sensor.delay_s);
+  c.sensor.noise_std_deg = sensor.get("noise_std_deg", c.sensor.noise_std_deg);
+  c.sensor.drift_deg_per_sqrt_s = sensor.get("drift_deg_per_sqrt_s", c.sensor.drift_deg_per_sqrt_s);
+
+  const auto camera = s.section("camera");
+  require_known_keys(camera, {"fov_deg", "range_m", "angle_noise_std_deg"});
+  c.camera.fov_deg = camera.get("fov_deg", c.camera.fov_deg);
+  c.camera.range_m = camera.get("range_m", c.camera.range_m);
+  c.camera.angle_noise_std_deg = camera.get("angle_noise_std_deg", c.camera.angle_noise_std_deg);
+
+  const auto gusts = s.section("gusts");
+  require_known_keys(gusts, {"std_per_speed", "time_constant_s"});
+  c.yaw_gust_std_per_speed = gusts.get("std_per_speed", c.yaw_gust_std_per_speed);
+  c.yaw_gust_time_constant_s = gusts.get("time_constant_s", c.yaw_gust_time_constant_s);
+
+  c.physics_substeps = s.get("physics_substeps", c.physics_substeps);
+  c.max_time_s = s.get("max_time_s", c.max_time_s);
+  c.settle_band_deg = s.get("settle_band_deg", c.settle_band_deg);
+  if (c.sensor.rate_hz <= 0 || c.sensor.delay_s < 0 || c.sensor.noise_std_deg < 0 || c.physics_substeps < 1 ||
+      c.yaw_gust_time_constant_s <= 0 || c.max_time_s <= 0)
+    throw std::runtime_error(s.origin() + ": rates, time constants and max_time_s must be positive, delays and noise >= 0, "
+                             "physics_substeps >= 1");
+  return c;
+}
+
+}  // namespace aerie::sim

@@ -1,0 +1,126 @@
+#pragma once
+// The simulated flight environment: a textured room (floor with a helipad, four walls,
+// ceiling), boxes and pillars as obstacles. World frame: x east, y north, z up (metres);
+// the floor is z = 0 and the room is centred on the origin in x and y.
+// The geometry is exact and public so that other components can take their ground truth
+// from it (occupancy for mapping, distances for planning, ray casts for depth).
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace aerie::sim {
+
+struct WorldConfig {
+  uint64_t seed = 1;              // every random choice (layout, textures) derives from it
+  double room_x = 12.0;           // interior size along x, y, z (m)
+  double room_y = 10.0;
+  double room_z = 4.0;
+  int n_obstacles = 6;            // boxes and pillars, placed clear of the flight route
+  double helipad_size = 1.0;      // side of the square helipad marking (m)
+  double helipad_yaw_deg = 0.0;   // rotation of the marking about z
+  double texels_per_metre = 200;  // resolution of the procedural textures (level 0)
+  double route_margin = 1.6;      // distance of the survey route from the walls (m)
+  double route_clearance = 0.7;   // obstacles keep at least this xy distance from the route (m)
+  double cruise_altitude = 1.5;   // altitude of the survey route (m)
+};
+
+// Axis-aligned box [min, max].
+struct Aabb {
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
+  bool contains(const Eigen::Vector3d& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+  Eigen::Vector3d size() const { return max - min; }
+  Eigen::Vector3d center() const { return 0.5 * (min + max); }
+};
+
+struct Obstacle {
+  enum class Kind { Box, Pillar };
+  Kind kind = Kind::Box;
+  Aabb box;
+};
+
+// The helipad marking on the floor: a dark square of side `size` with a white ring and
+// a white "H", centred at `center` (z = 0), rotated by `yaw` about z.
+struct Helipad {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double yaw = 0.0;   // rad; the H's bar is along the pad's local x axis
+  double size = 1.0;  // m
+  // Corners of the square, counter-clockwise seen from above, starting at local (-s/2, -s/2).
+  std::array<Eigen::Vector3d, 4> corners() const;
+};
+
+// A flat textured rectangle on the plane x[axis] == offset, facing `normal_sign` along that
+// axis. Texture coordinates are metres along (u_axis, v_axis) from (u0, v0), v_sign flips v.
+struct Surface {
+  int axis = 2;
+  double offset = 0.0;
+  int normal_sign = 1;
+  int u_axis = 0, v_axis = 1;
+  double u0 = 0, v0 = 0;
+  int v_sign = 1;
+  double u_len = 0, v_len = 0;      // extent (m)
+  cv::Vec3f tint{1.f, 1.f, 1.f};    // BGR multiplier for colour output
+  float shade = 1.f;                // constant diffuse shading of the face
+};
+
+struct RayHit {
+  double t = 0.0;                 // ray parameter: point = origin + t * direction
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  int surface = -1;               // index into World::surfaces()
+};
+
+class Textures;  // mip-mapped procedural textures, one per surface (texture.hpp)
+
+class World {
+ public:
+  // The standard room of issue 2 (deterministic for a config).
+  static World room(const WorldConfig& config);
+
+  const WorldConfig& config() const { return config_; }
+  // Interior of the room (free space is inside it and outside every obstacle).
+  const Aabb& bounds() const { return bounds_; }
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  const Helipad& helipad() const { return helipad_; }
+
+  // True inside an obstacle or outside the room interior (walls are solid).
+  bool occupied(const Eigen::Vector3d& p) const;
+  // Euclidean distance to the nearest surface (wall, floor, ceiling, obstacle face).
+  double distance(const Eigen::Vector3d& p) const;
+  // Signed version: > 0 in free space, < 0 inside solid (obstacles or beyond the walls).
+  double signed_distance(const Eigen::Vector3d& p) const;
+  // First surface hit by origin + t * direction with t in (0, max_t]; direction need not
+  // be unit (t is then in units of |direction|).
+  std::optional<RayHit> raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                double max_t = 1e9) const;
+
+  // The survey route the scripted trajectories fly (xy rounded rectangle at cruise altitude,
+  // `route_margin` from the walls) and the take-off point (on the route, on the floor).
+  struct Route {
+    double x_min, x_max, y_min, y_max, corner_radius, altitude;
+    Eigen::Vector3d home;
+  };
+  const Route& route() const { return route_; }
+
+  const std::vector<Surface>& surfaces() const { return surfaces_; }
+  const Textures& textures() const { return *textures_; }
+
+ private:
+  WorldConfig config_;
+  Aabb bounds_;
+  std::vector<Obstacle> obstacles_;
+  Helipad helipad_;
+  Route route_{};
+  std::vector<Surface> surfaces_;
+  std::shared_ptr<const Textures> textures_;  // shared: copies of a World are cheap
+};
+
+}  // namespace aerie::sim

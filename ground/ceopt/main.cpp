@@ -1,0 +1,185 @@
+// aerie-ceopt: tunes the heading FLC by cross-entropy in simulation (thesis 5.1.4-5.1.5),
+// prunes it, flies the avoidance experiment of 5.1.6 and writes the controllers (YAML,
+// FLL) and a report with plots. Progress goes to the terminal and to CE_PROGRESS;
+// the chosen controller can be sent to aerie-control on FLC_PARAMS.
+#include <aerie/ce_progress_t.hpp>
+#include <aerie/flc_params_t.hpp>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <sstream>
+
+#include "common/bus/bus.hpp"
+#include "common/bus/channels.hpp"
+#include "common/bus/node.hpp"
+#include "common/bus/status.hpp"
+#include "common/flc/flc_io.hpp"
+#include "common/util/cli.hpp"
+#include "common/util/time.hpp"
+#include "ground/ceopt/pipeline.hpp"
+#include "ground/ceopt/report.hpp"
+#include "ground/ceopt/thread_pool.hpp"
+
+using namespace aerie;
+using namespace aerie::ceopt;
+
+namespace {
+
+aerie::flc_params_t params_message(const flc::FlcSpec& spec, int64_t seq) {
+  aerie::flc_params_t m;
+  m.utime = util::wall_utime();
+  m.seq = seq;
+  m.controller_id = spec.id;
+  m.names = spec.parameter_names();
+  for (const auto& n : m.names) m.values.push_back(spec.parameter(n));
+  m.nparams = static_cast<int32_t>(m.names.size());
+  m.fll = flc::to_fll(spec);
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"aerie-ceopt: cross-entropy optimisation of the heading fuzzy controller in simulation (thesis 5.1.4-5.1.6)"};
+  util::CommonOptions common;
+  util::add_common_options(app, common);
+  std::string out = "ceopt-out", plot_script = AERIE_CEOPT_PLOT_SCRIPT, publish = "none";
+  std::string progress_channel = channels::kCeProgress, params_channel = channels::kFlcParams;
+  int threads = -1, iterations = -1, samples = -1, runs = -1;
+  int64_t seed = -1;
+  bool no_plots = false, no_experiment = false, no_lcm = false;
+  app.add_option("-o,--out", out, "output folder (controllers, CSV, report.md, PNG plots)");
+  app.add_option("--seed", seed, "CE seed (overrides ce.seed); the run is reproducible from it whatever --threads");
+  app.add_option("--threads", threads, "evaluation threads (0 = all cores; overrides threads)");
+  app.add_option("--iterations", iterations, "CE iterations per stage (overrides ce.iterations)");
+  app.add_option("--samples", samples, "CE candidates per iteration N (overrides ce.samples)");
+  app.add_option("--runs", runs, "experiment runs per speed and controller (overrides evaluation.runs_per_speed)");
+  app.add_flag("--no-experiment", no_experiment, "only optimise (no evaluation runs)");
+  app.add_flag("--no-plots", no_plots, "do not draw the PNG plots");
+  app.add_option("--plot-script", plot_script, "the plotting script (python3 + matplotlib)");
+  app.add_flag("--no-lcm", no_lcm, "do not publish CE_PROGRESS / FLC_PARAMS / status");
+  app.add_option("--progress-channel", progress_channel, "channel for aerie.ce_progress_t");
+  app.add_option("--params-channel", params_channel, "channel for aerie.flc_params_t");
+  app.add_option("--publish", publish, "controller to send on the params channel at the end")
+      ->check(CLI::IsMember({"none", "sf", "sfmf", "pruned"}));
+  CLI11_PARSE(app, argc, argv);
+  util::init_logging("ceopt", common.log_level);
+
+  try {
+    CeoptConfig cfg = common.config.empty() ? default_ceopt_config() : ceopt_config_from(util::Config::load(common.config));
+    if (seed >= 0) cfg.ce.seed = static_cast<uint64_t>(seed);
+    if (threads >= 0) cfg.threads = threads;
+    if (iterations > 0) cfg.ce.max_iterations = iterations;
+    if (samples > 0) cfg.ce.samples = samples;
+    if (runs > 0) cfg.evaluation.runs_per_speed = runs;
+    cfg.ce.validate();
+
+    std::unique_ptr<bus::Bus> lcm;
+    std::unique_ptr<bus::StatusReporter> status;
+    if (!no_lcm) {
+      try {
+        lcm = std::make_unique<bus::Bus>(common.lcm_url);
+        status = std::make_unique<bus::StatusReporter>(*lcm, "ceopt");
+      } catch (const std::exception& e) {
+        spdlog::warn("LCM unavailable ({}): progress on the terminal only (use --lcm-url or --no-lcm)", e.what());
+      }
+    }
+    bus::install_stop_handlers();
+    ThreadPool pool(cfg.threads);
+    std::ostringstream cmdline;
+    for (int i = 0; i < argc; ++i) cmdline << (i ? " " : "") << argv[i];
+    spdlog::info("{} threads; CE N = {}, N_elite = {}, {} iterations per stage, {} training runs per candidate; load {}",
+                 pool.size(), cfg.ce.samples, cfg.ce.elite, cfg.ce.max_iterations,
+                 cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed), read_loadavg());
+
+    const std::string run_id = "ceopt-seed" + std::to_string(cfg.ce.seed);
+    int64_t seq = 0;
+    const util::Stopwatch watch;
+    auto on_iteration = [&](int stage, const std::vector<std::string>& names, const CeIteration& it) {
+      std::ostringstream sig;
+      for (size_t j = 0; j < names.size(); ++j) sig << " " << names[j] << "=" << it.mean[j] << "±" << it.sigma[j];
+      spdlog::info("stage {} iter {:3d}/{}  best {:.1f}  iter-best {:.1f}  eta {:.3f} |{}  ({:.1f} s)", stage, it.iteration,
+                   cfg.ce.max_iterations, it.best_cost, it.iteration_best_cost, it.eta, sig.str(), watch.ms() / 1000);
+      if (lcm) {
+        aerie::ce_progress_t m;
+        m.utime = util::wall_utime();
+        m.seq = seq++;
+        m.run_id = run_id;
+        m.stage = stage;
+        m.iteration = it.iteration;
+        m.evaluations = it.evaluations;
+        m.nparams = static_cast<int32_t>(names.size());
+        m.names = names;
+        m.mean = it.mean;
+        m.sigma = it.sigma;
+        m.best_cost = it.best_cost;
+        m.iteration_best_cost = it.iteration_best_cost;
+        m.nelite = static_cast<int32_t>(it.elite_costs.size());
+        m.elite_costs = it.elite_costs;
+        lcm->publish(progress_channel, m);
+        status->set("stage", stage);
+        status->set("iteration", it.iteration);
+        status->count("evaluations", cfg.ce.samples);
+        status->ok("stage " + std::to_string(stage) + " iteration " + std::to_string(it.iteration));
+        status->tick();
+      }
+      return !bus::stop_requested();
+    };
+
+    ReportInputs in;
+    in.config = &cfg;
+    in.threads = pool.size();
+    in.command_line = cmdline.str();
+    in.load_before = read_loadavg();
+    const TuningResult tuning = run_tuning(cfg, pool, on_iteration);
+    in.load_after = read_loadavg();
+    in.tuning = &tuning;
+    const bool complete = !tuning.stage2.ce.history.empty() && tuning.stage2.ce.stop_reason != "cancelled";
+    spdlog::info("stage 1: {:.1f} s, best cost {:.1f} (iteration {}); stage 2: {:.1f} s, best cost {:.1f} (iteration {})",
+                 tuning.stage1.seconds, tuning.stage1.ce.best_cost, tuning.stage1.ce.best_iteration, tuning.stage2.seconds,
+                 tuning.stage2.ce.best_cost, tuning.stage2.ce.best_iteration);
+    in.controllers.emplace_back("initial", tuning.initial);
+    if (!tuning.stage1.ce.best.empty()) in.controllers.emplace_back("sf", tuning.stage1.controller);
+    if (!tuning.stage2.ce.best.empty()) in.controllers.emplace_back("sfmf", tuning.stage2.controller);
+    if (complete) {
+      in.controllers.emplace_back("pruned", tuning.pruned);
+      spdlog::info("pruned: {} -> {} rules, {} -> {} sets", tuning.prune_report.rules_before, tuning.prune_report.rules_after,
+                   tuning.prune_report.sets_before, tuning.prune_report.sets_after);
+    } else {
+      spdlog::warn("interrupted: writing what was optimised so far");
+    }
+    if (!no_experiment && !bus::stop_requested()) {
+      spdlog::info("experiment: {} controllers x {} speeds x {} runs", in.controllers.size(), cfg.evaluation.speeds.size(),
+                   cfg.evaluation.runs_per_speed);
+      in.runs = run_experiment(in.controllers, cfg, pool);
+      for (const auto& s : summarise(in.runs))
+        spdlog::info("  {:8s} {:.1f} m/s: RMSE {:.2f} ± {:.2f} deg ({} settled), min wall distance {:.2f} m, {} in dangerous area",
+                     s.controller, s.speed, s.rmse_mean, s.rmse_std, s.settled, s.min_wall_distance, s.entered_dangerous);
+    }
+    const auto files = write_report(out, in);
+    spdlog::info("wrote {} files to {}", files.size(), out);
+    if (!no_plots) {
+      std::string err;
+      if (draw_plots(out, plot_script, &err))
+        spdlog::info("plots in {}", out);
+      else
+        spdlog::warn("{}", err);
+    }
+    if (publish != "none" && lcm) {
+      bool sent = false;
+      for (const auto& [name, spec] : in.controllers)
+        if (name == publish) {
+          lcm->publish(params_channel, params_message(spec, 0));
+          spdlog::info("sent controller '{}' ({}) on {}", name, spec.id, params_channel);
+          sent = true;
+        }
+      if (!sent) spdlog::warn("controller '{}' was not produced (interrupted?), nothing sent", publish);
+    }
+    if (status) status->publish_now();
+    return complete ? 0 : 130;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}

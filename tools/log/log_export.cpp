@@ -1,0 +1,226 @@
+#include "tools/log/log_export.hpp"
+
+#include <aerie/gt_box_t.hpp>
+#include <aerie/gt_pose_t.hpp>
+#include <aerie/image_t.hpp>
+#include <aerie/pose_t.hpp>
+#include <aerie/stereo_image_t.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <stdexcept>
+
+#include "common/image/image_message.hpp"
+#include "tools/log/type_registry.hpp"
+
+namespace aerie::logtools {
+namespace fs = std::filesystem;
+
+std::string utime_to_seconds(int64_t utime) {
+  char buf[48];
+  const char* sign = utime < 0 ? "-" : "";
+  const uint64_t u = static_cast<uint64_t>(utime < 0 ? -utime : utime);
+  std::snprintf(buf, sizeof buf, "%s%llu.%06llu", sign, static_cast<unsigned long long>(u / 1'000'000),
+                static_cast<unsigned long long>(u % 1'000'000));
+  return buf;
+}
+
+namespace {
+
+std::ofstream open_out(const fs::path& p) {
+  std::ofstream f(p);
+  if (!f) throw std::runtime_error(p.string() + ": cannot create file");
+  return f;
+}
+
+void write_png(const fs::path& p, const cv::Mat& img) {
+  if (!cv::imwrite(p.string(), img)) throw std::runtime_error(p.string() + ": cannot write PNG");
+}
+
+std::string frame_name(int64_t i) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%06lld.png", static_cast<long long>(i));
+  return buf;
+}
+
+// One exporter per message type; consume() returns false for an undecodable payload.
+class Exporter {
+ public:
+  virtual ~Exporter() = default;
+  virtual bool consume(const logio::Event& ev) = 0;
+};
+
+template <typename Msg>
+bool decode(const logio::Event& ev, Msg& m) {
+  return m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) >= 0;
+}
+
+class ImageExporter final : public Exporter {
+ public:
+  ImageExporter(const fs::path& dir, ExportResult& r) : dir_(dir), times_(open_out(dir / "times.txt")) {
+    r.outputs = {dir.string() + "/NNNNNN.png", (dir / "times.txt").string()};
+  }
+  bool consume(const logio::Event& ev) override {
+    aerie::image_t m;
+    if (!decode(ev, m)) return false;
+    cv::Mat img;
+    try {
+      img = image::from_message(m);
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
+    write_png(dir_ / frame_name(n_++), img);
+    times_ << utime_to_seconds(m.utime) << "\n";
+    return true;
+  }
+
+ private:
+  fs::path dir_;
+  std::ofstream times_;
+  int64_t n_ = 0;
+};
+
+class StereoExporter final : public Exporter {
+ public:
+  StereoExporter(const fs::path& dir, ExportResult& r) : dir_(dir), times_(open_out(dir / "times.txt")) {
+    fs::create_directories(dir / "image_l");
+    fs::create_directories(dir / "image_r");
+    r.outputs = {(dir / "image_l").string(), (dir / "image_r").string(), (dir / "times.txt").string(),
+                 (dir / "calib.txt").string()};
+  }
+  bool consume(const logio::Event& ev) override {
+    aerie::stereo_image_t m;
+    if (!decode(ev, m)) return false;
+    cv::Mat l, r;
+    try {
+      l = image::from_message(m.left);
+      r = image::from_message(m.right);
+    } catch (const std::invalid_argument&) {
+      return false;
+    }
+    if (n_ == 0) write_calib(m);
+    write_png(dir_ / "image_l" / frame_name(n_), l);
+    write_png(dir_ / "image_r" / frame_name(n_), r);
+    ++n_;
+    times_ << utime_to_seconds(m.utime) << "\n";
+    return true;
+  }
+
+ private:
+  // KITTI calib.txt: rectified 3x4 projection matrices, P1[0,3] = -fx * baseline.
+  void write_calib(const aerie::stereo_image_t& m) {
+    auto f = open_out(dir_ / "calib.txt");
+    char line[512];
+    for (int cam = 0; cam < 2; ++cam) {
+      std::snprintf(line, sizeof line, "P%d: %.12e 0 %.12e %.12e 0 %.12e %.12e 0 0 0 1 0\n", cam, m.fx, m.cx,
+                    cam ? -m.fx * m.baseline_m : 0.0, m.fy, m.cy);
+      f << line;
+    }
+  }
+  fs::path dir_;
+  std::ofstream times_;
+  int64_t n_ = 0;
+};
+
+// TUM trajectory: timestamp tx ty tz qx qy qz qw (our messages store w, x, y, z).
+template <typename Msg>
+class TumExporter final : public Exporter {
+ public:
+  TumExporter(const fs::path& file, ExportResult& r) : out_(open_out(file)) { r.outputs = {file.string()}; }
+  bool consume(const logio::Event& ev) override {
+    Msg m{};
+    if (!decode(ev, m)) return false;
+    char line[256];
+    std::snprintf(line, sizeof line, "%s %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", utime_to_seconds(m.utime).c_str(),
+                  m.position[0], m.position[1], m.position[2], m.orientation[1], m.orientation[2],
+                  m.orientation[3], m.orientation[0]);
+    out_ << line;
+    return true;
+  }
+
+ private:
+  std::ofstream out_;
+};
+
+class BoxExporter final : public Exporter {
+ public:
+  BoxExporter(const fs::path& file, ExportResult& r) : out_(open_out(file)) {
+    r.outputs = {file.string()};
+    out_ << "t,visible,x,y,width,height\n";
+  }
+  bool consume(const logio::Event& ev) override {
+    aerie::gt_box_t m;
+    if (!decode(ev, m)) return false;
+    char line[256];
+    std::snprintf(line, sizeof line, "%s,%d,%.3f,%.3f,%.3f,%.3f\n", utime_to_seconds(m.utime).c_str(),
+                  m.visible ? 1 : 0, m.x, m.y, m.width, m.height);
+    out_ << line;
+    return true;
+  }
+
+ private:
+  std::ofstream out_;
+};
+
+std::unique_ptr<Exporter> make_exporter(const std::string& type, const std::string& channel, const fs::path& dir,
+                                        ExportResult& r) {
+  if (type == "aerie.image_t") return std::make_unique<ImageExporter>(dir, r);
+  if (type == "aerie.stereo_image_t") return std::make_unique<StereoExporter>(dir, r);
+  if (type == "aerie.gt_pose_t") return std::make_unique<TumExporter<aerie::gt_pose_t>>(dir / (channel + ".tum"), r);
+  if (type == "aerie.pose_t") return std::make_unique<TumExporter<aerie::pose_t>>(dir / (channel + ".tum"), r);
+  if (type == "aerie.gt_box_t") return std::make_unique<BoxExporter>(dir / (channel + ".csv"), r);
+  return nullptr;
+}
+
+}  // namespace
+
+ExportResult export_channel(const std::string& log_path, const std::string& channel, const std::string& out_dir,
+                            bool resync) {
+  logio::Reader reader(log_path, {.resync = resync});
+  ExportResult r;
+  std::unique_ptr<Exporter> exporter;
+  int64_t fingerprint = 0;
+  std::set<std::string> channels;
+  logio::Event ev;
+  while (reader.next(ev)) {
+    if (ev.channel != channel) {
+      channels.insert(ev.channel);
+      continue;
+    }
+    const int64_t fp = fingerprint_of(ev.data.data(), ev.data.size());
+    if (!exporter) {
+      const TypeInfo* t = find_type(fp);
+      if (!t) {  // an unknown or corrupt first payload: look at the next message
+        ++r.undecodable;
+        continue;
+      }
+      r.type = t->name;
+      fs::create_directories(out_dir);
+      exporter = make_exporter(r.type, channel, out_dir, r);
+      if (!exporter)
+        throw std::runtime_error(log_path + ": channel " + channel + " carries " + r.type +
+                                 ", which cannot be exported (images, stereo pairs, poses and boxes can)");
+      fingerprint = fp;
+    }
+    if (fp != fingerprint) {
+      ++r.other_type;
+    } else if (exporter->consume(ev)) {
+      ++r.exported;
+    } else {
+      ++r.undecodable;
+    }
+  }
+  r.damage = reader.damage();
+  if (!exporter && r.undecodable == 0) {
+    std::string list;
+    for (const auto& c : channels) list += (list.empty() ? "" : ", ") + c;
+    throw std::runtime_error(log_path + ": no messages on channel " + channel + " (channels: " +
+                             (list.empty() ? "none" : list) + ")");
+  }
+  return r;
+}
+
+}  // namespace aerie::logtools

@@ -1,0 +1,33 @@
+#pragma once
+// `aerie-log export`: one channel of a log to files other tools read.
+//   aerie.image_t        -> DIR/000000.png ... + DIR/times.txt (s, message utime)
+//   aerie.stereo_image_t -> DIR/image_l/, DIR/image_r/ PNGs + times.txt + calib.txt:
+//                           a KITTI-odometry-style folder (aerie-capture --source kitti reads it)
+//   aerie.gt_pose_t, aerie.pose_t -> DIR/<CHANNEL>.tum: "t x y z qx qy qz qw" per line
+//   aerie.gt_box_t       -> DIR/<CHANNEL>.csv: "t,visible,x,y,width,height"
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/logio/event_log.hpp"
+
+namespace aerie::logtools {
+
+struct ExportResult {
+  std::string type;             // message type of the channel
+  int64_t exported = 0;         // messages written out
+  int64_t undecodable = 0;      // skipped: corrupt payload
+  int64_t other_type = 0;       // skipped: another type on the same channel
+  std::vector<std::string> outputs;  // files/folders written (top level)
+  std::vector<logio::Damage> damage;
+};
+
+// Throws std::runtime_error naming the log/channel when the channel is absent or its
+// type cannot be exported, or naming the file when an output cannot be written.
+ExportResult export_channel(const std::string& log_path, const std::string& channel, const std::string& out_dir,
+                            bool resync = false);
+
+// "1403715273.262143" for utime 1403715273262143: exact, no floating point.
+std::string utime_to_seconds(int64_t utime);
+
+}  // namespace aerie::logtools
