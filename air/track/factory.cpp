@@ -52,6 +52,7 @@ DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
   in.read("max_levels", p.max_levels);
   in.read("min_size", p.min_size);
   in.read("search_radius", p.search_radius);
+  in.read("coarse_radius", p.coarse_radius);
   in.read("pos_radius", p.pos_radius);
   in.read("neg_inner", p.neg_inner);
   in.read("neg_outer", p.neg_outer);

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
   CLI::App app{"OTB one-pass evaluation of Aerie's trackers and OpenCV's reference trackers"};
   std::string data, out = "track-bench", trackers_arg, sequences_arg, config_path, resize_arg;
   uint64_t seed = 1;
-  int max_frames = 0;
+  int max_frames = 0, repeats = 1;
   bool no_plots = false, states = false;
   std::string log_level = "info";
   app.add_option("--data", data, "folder of sequences: <SEQ>/img/* and <SEQ>/groundtruth.txt")->required();
@@ -77,8 +77,13 @@ int main(int argc, char** argv) {
   app.add_option("--trackers", trackers_arg,
                  "comma-separated tracker names (default: all of Aerie's and OpenCV's)");
   app.add_option("--sequences", sequences_arg, "comma-separated sequence names (default: all under --data)");
-  app.add_option("-c,--config", config_path, "track.yaml with per-tracker parameter sections")->check(CLI::ExistingFile);
+  app.add_option("-c,--config", config_path, "track.yaml (its trackers: sections) or a YAML of tracker sections")
+      ->check(CLI::ExistingFile);
   app.add_option("--seed", seed, "seed of every tracker")->capture_default_str();
+  app.add_option("--runs", repeats, "runs of each of Aerie's (randomised) trackers with seeds seed, seed+1, ...; "
+                                    "the figures are their means, the box files those of the first run")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   app.add_option("--resize", resize_arg, "resize frames and boxes to WxH (e.g. 640x480) before tracking");
   app.add_option("--max-frames", max_frames, "use at most this many frames per sequence (0 = all)");
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
@@ -96,7 +101,9 @@ int main(int argc, char** argv) {
     }
     for (const auto& t : trackers)
       if (!is_known_tracker(t)) throw std::invalid_argument("--trackers: unknown tracker '" + t + "'");
-    const aerie::util::Config config = config_path.empty() ? aerie::util::Config() : aerie::util::Config::load(config_path);
+    // A full track.yaml has the tracker sections under "trackers:"; a bare file has them at the top.
+    aerie::util::Config config = config_path.empty() ? aerie::util::Config() : aerie::util::Config::load(config_path);
+    if (config.has("trackers")) config = config.section("trackers");
     cv::Size resize;
     if (!resize_arg.empty() && std::sscanf(resize_arg.c_str(), "%dx%d", &resize.width, &resize.height) != 2)
       throw std::invalid_argument("--resize: expected WxH, got '" + resize_arg + "'");
@@ -119,15 +126,24 @@ int main(int argc, char** argv) {
     std::vector<Run> runs;
     for (const auto& seq : sequences) {
       const size_t n = max_frames > 0 ? std::min<size_t>(max_frames, seq.frames.size()) : seq.frames.size();
-      std::vector<std::unique_ptr<Tracker>> ts;
-      std::vector<Run> seq_runs(trackers.size());
-      std::vector<std::vector<cv::Rect2d>> boxes(trackers.size());
-      std::vector<std::vector<TrackState>> track_states(trackers.size());
+      // One instance per tracker and run (seeds seed, seed + 1, ...; OpenCV's trackers run once).
+      struct Instance {
+        size_t tracker;
+        std::unique_ptr<Tracker> t;
+        Run run;
+        std::vector<cv::Rect2d> boxes;
+        std::vector<TrackState> states;
+      };
+      std::vector<Instance> inst;
       for (size_t k = 0; k < trackers.size(); ++k) {
-        ts.push_back(make_tracker(trackers[k], config.section(trackers[k]), seed));
-        seq_runs[k].tracker = trackers[k];
-        seq_runs[k].sequence = seq.name;
-        seq_runs[k].frames = static_cast<int>(n);
+        const int r_count = trackers[k].rfind("opencv-", 0) == 0 ? 1 : repeats;
+        for (int r = 0; r < r_count; ++r) {
+          Instance in{k, make_tracker(trackers[k], config.section(trackers[k]), seed + r), {}, {}, {}};
+          in.run.tracker = trackers[k];
+          in.run.sequence = seq.name;
+          in.run.frames = static_cast<int>(n);
+          inst.push_back(std::move(in));
+        }
       }
       std::vector<cv::Rect2d> gt(seq.groundtruth.begin(), seq.groundtruth.begin() + n);
       double sx = 1, sy = 1;
@@ -141,49 +157,85 @@ int main(int argc, char** argv) {
         }
         if (i == 0)
           for (auto& b : gt) b = scaled(b, sx, sy);
-        for (size_t k = 0; k < ts.size(); ++k) {
-          Run& r = seq_runs[k];
+        for (auto& in : inst) {
+          Run& r = in.run;
           if (!r.error.empty()) {
-            boxes[k].push_back(boxes[k].back());
+            in.boxes.push_back(in.boxes.back());
             continue;
           }
           try {
             if (i == 0) {
-              ts[k]->init(frame, gt[0]);
-              boxes[k].push_back(gt[0]);
+              in.t->init(frame, gt[0]);
+              in.boxes.push_back(gt[0]);
               continue;
             }
             const auto t0 = std::chrono::steady_clock::now();
             const double c0 = thread_cpu_seconds();
-            const TrackState s = ts[k]->update(frame);
+            const TrackState s = in.t->update(frame);
             r.update_cpu_seconds += thread_cpu_seconds() - c0;
             r.update_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             r.samples += s.samples_evaluated();
             r.lost += s.lost;
             r.redetected += s.redetected;
-            boxes[k].push_back(s.box());
-            if (states) track_states[k].push_back(s);
+            in.boxes.push_back(s.box());
+            if (states) in.states.push_back(s);
           } catch (const std::exception& e) {
             r.error = e.what();
-            spdlog::warn("{} on {} frame {}: {}", trackers[k], seq.name, i + 1, e.what());
-            boxes[k].push_back(boxes[k].empty() ? gt[0] : boxes[k].back());
+            spdlog::warn("{} on {} frame {}: {}", r.tracker, seq.name, i + 1, e.what());
+            in.boxes.push_back(in.boxes.empty() ? gt[0] : in.boxes.back());
           }
         }
       }
-      for (size_t k = 0; k < ts.size(); ++k) {
-        Run& r = seq_runs[k];
-        r.score = eval::score(boxes[k], gt);
-        eval::write_boxes(fs::path(out) / trackers[k] / (seq.name + ".txt"), boxes[k]);
-        if (states && track_states[k].size() + 1 == n) {
-          std::ofstream f(fs::path(out) / trackers[k] / (seq.name + ".states.csv"));
-          f << "frame,x,y,scale,confidence,lost,redetected,samples,iou\n";
-          for (size_t i = 1; i < n; ++i) {
-            const TrackState& t = track_states[k][i - 1];
-            f << i + 1 << ',' << t.pose.x << ',' << t.pose.y << ',' << t.pose.scale << ',' << t.confidence << ','
-              << t.lost << ',' << t.redetected << ',' << t.samples_evaluated() << ',' << eval::iou(boxes[k][i], gt[i])
-              << '\n';
+      for (size_t k = 0; k < trackers.size(); ++k) {
+        // The mean over the runs of this tracker; the files are those of the first run.
+        Run mean;
+        int count = 0;
+        for (auto& in : inst) {
+          if (in.tracker != k) continue;
+          in.run.score = eval::score(in.boxes, gt);
+          if (count++ == 0) {
+            mean = in.run;
+            eval::write_boxes(fs::path(out) / trackers[k] / (seq.name + ".txt"), in.boxes);
+            if (states && in.states.size() + 1 == n) {
+              std::ofstream f(fs::path(out) / trackers[k] / (seq.name + ".states.csv"));
+              f << "frame,x,y,scale,confidence,lost,redetected,samples,iou\n";
+              for (size_t i = 1; i < n; ++i) {
+                const TrackState& t = in.states[i - 1];
+                f << i + 1 << ',' << t.pose.x << ',' << t.pose.y << ',' << t.pose.scale << ',' << t.confidence << ','
+                  << t.lost << ',' << t.redetected << ',' << t.samples_evaluated() << ','
+                  << eval::iou(in.boxes[i], gt[i]) << '\n';
+              }
+            }
+            continue;
           }
+          auto add = [](std::vector<double>& a, const std::vector<double>& b) {
+            for (size_t i = 0; i < a.size(); ++i) a[i] += b[i];
+          };
+          add(mean.score.success, in.run.score.success);
+          add(mean.score.precision, in.run.score.precision);
+          mean.score.auc += in.run.score.auc;
+          mean.score.precision20 += in.run.score.precision20;
+          mean.score.mean_centre_error += in.run.score.mean_centre_error;
+          mean.update_seconds += in.run.update_seconds;
+          mean.update_cpu_seconds += in.run.update_cpu_seconds;
+          mean.samples += in.run.samples;
+          mean.lost += in.run.lost;
+          mean.redetected += in.run.redetected;
+          if (mean.error.empty()) mean.error = in.run.error;
         }
+        if (count > 1) {
+          for (auto& v : mean.score.success) v /= count;
+          for (auto& v : mean.score.precision) v /= count;
+          mean.score.auc /= count;
+          mean.score.precision20 /= count;
+          mean.score.mean_centre_error /= count;
+          mean.update_seconds /= count;
+          mean.update_cpu_seconds /= count;
+          mean.samples /= count;
+          mean.lost /= count;
+          mean.redetected /= count;
+        }
+        const Run& r = mean;
         spdlog::info("{:>18} {:<26} AUC {:.3f}  P20 {:.3f}  CLE {:7.1f}  {:8.1f} fps ({:8.1f} cpu)  {:6.0f} samples/frame{}",
                      r.tracker, r.sequence, r.score.auc, r.score.precision20, r.score.mean_centre_error, r.fps(), r.cpu_fps(),
                      n > 1 ? r.samples / (n - 1) : 0.0, r.error.empty() ? "" : "  (failed: " + r.error + ")");

@@ -53,8 +53,8 @@ DiscriminativeTracker::DiscriminativeTracker(std::string name, DiscriminativePar
     if (!ok) throw std::invalid_argument(name_ + ": parameter " + what);
   };
   require(p.max_levels >= 1 && p.max_levels <= 6, "max_levels must be in [1, 6]");
-  require(p.min_size >= 4, "min_size must be >= 4 pixels");
-  require(p.search_radius >= 1, "search_radius must be >= 1");
+  require(p.min_size >= 2, "min_size must be >= 2 pixels");
+  require(p.search_radius >= 1 && p.coarse_radius >= 1, "search_radius and coarse_radius must be >= 1");
   require(p.pos_radius > 0 && p.pos_radius < p.neg_inner && p.neg_inner < p.neg_outer,
           "radii must satisfy 0 < pos_radius < neg_inner < neg_outer");
   require(p.neg_count >= 1, "neg_count must be >= 1");
@@ -144,7 +144,7 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
   Search out;
   const int top = levels() - 1;
   cv::Point2d c = centre_ * (1.0 / (1 << top));  // eq. 3.13: previous frame's location at the coarsest level
-  double radius = std::max(1.0, params_.search_radius / (1 << top));
+  double radius = top == 0 ? params_.search_radius : params_.coarse_radius;
   std::vector<float> scores;
   for (int p = top; p >= 0; --p) {
     Level& L = levels_[p];
@@ -289,8 +289,9 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   if (!lost_) {
     // Region that the search, the scale candidates and the training samples can reach.
     const int top = levels() - 1;
-    const double reach = std::max(params_.search_radius, top > 0 ? params_.max_radius * (1 << (top - 1)) : 0.0) +
-                         params_.neg_outer + (2 << top) + 2;
+    const double search = top == 0 ? params_.search_radius
+                                   : std::max(params_.coarse_radius * (1 << top), params_.max_radius * (1 << (top - 1)));
+    const double reach = search + params_.neg_outer + (2 << top) + 2;
     const cv::Size2d half = init_size_ * (scale_ * params_.scale_step / 2);
     build_pyramid(frame, gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
                                            static_cast<int>(centre_.y - half.height - reach)),
@@ -301,12 +302,10 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   }
   Search s = search(lost_);
   state.levels = std::move(s.levels);
-  double score = s.score;
-  (void)score;
   const cv::Point2d previous = centre_;
   const double previous_scale = scale_;
   centre_ = s.centre;
-  if (scales.size() > 1 && !lost_) score = adapt_scale(s.centre, scales);
+  if (scales.size() > 1 && !lost_) adapt_scale(s.centre, scales);
   // Confidence: the prominence of the best sample relative to its running mean while tracking well.
   const double z = s.prominence;
   const double conf = scored_frames_ == 0 ? 1.0 : std::clamp(z / std::max(mean_prominence_, 1e-6), 0.0, 1.0);
@@ -317,7 +316,9 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   };
 
   if (!lost_) {
-    low_frames_ = conf < params_.update_confidence ? low_frames_ + 1 : 0;
+    // Hysteresis: once below update_confidence, learning resumes only at found_confidence.
+    const bool uncertain = low_frames_ > 0 ? conf < params_.found_confidence : conf < params_.update_confidence;
+    low_frames_ = uncertain ? low_frames_ + 1 : 0;
     if (low_frames_ == 0)
       confident_frame();
     else if (params_.redetection && low_frames_ >= params_.lost_frames)

@@ -3,7 +3,7 @@
 // multi-classifier multi-resolution framework of thesis 3.2.2 / 3.3.1 (AMCMR-CT, AM3):
 //
 //  * one adaptive classifier C^p per pyramid level (image halved per level), N_PL levels (eq. 3.23);
-//  * the coarsest level searches the integer offsets inside alpha / 2^(N_PL-1) (Table 3.1);
+//  * the coarsest level searches the integer offsets inside its radius (Table 3.1);
 //  * the best sample l^p is propagated to the next finer level as 2 l^p (eq. 3.24);
 //  * each level rejects the xi^p N_S lowest-scoring samples (eq. 3.25); the best of them is the
 //    critical sample, and twice its distance to l^p (the critical distance) is the next
@@ -54,9 +54,10 @@ struct DiscriminativeParams {
   std::vector<std::string> channels = {"gray", "gradient"};
   // Pyramid (eq. 3.23): N_PL = min(max_levels, floor(log2(min(T_W, T_H) / min_size))), at least 1.
   int max_levels = 1;
-  double min_size = 8;
+  double min_size = 3.5;
   // Algorithm 1 radii, in full-resolution pixels; level p uses them divided by 2^p.
-  double search_radius = 20;  // alpha: test samples strictly inside it (Table 3.1)
+  double search_radius = 20;  // alpha with one level: test samples strictly inside it (Table 3.1)
+  double coarse_radius = 5;   // alpha at the coarsest level when there are several, pixels of that level
   double pos_radius = 2.5;    // beta: positives strictly inside it
   double neg_inner = 8;       // gamma
   double neg_outer = 30;      // delta

@@ -26,8 +26,8 @@ FlowScale flow_scale(const cv::Mat& prev, const cv::Mat& next, const cv::Rect2d&
   std::vector<cv::Point2f> p0, p1, pb;
   for (int j = 0; j < grid; ++j)
     for (int i = 0; i < grid; ++i) {
-      const cv::Point2f p(static_cast<float>(box.x + box.width * (i + 0.5) / grid - roi.x),
-                          static_cast<float>(box.y + box.height * (j + 0.5) / grid - roi.y));
+      const cv::Point2f p(static_cast<float>(box.x + box.width * (0.2 + 0.6 * (i + 0.5) / grid) - roi.x),
+                          static_cast<float>(box.y + box.height * (0.2 + 0.6 * (j + 0.5) / grid) - roi.y));
       if (p.x >= 0 && p.y >= 0 && p.x < roi.width && p.y < roi.height) p0.push_back(p);
     }
   if (p0.size() < 8) return out;

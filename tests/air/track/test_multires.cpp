@@ -48,7 +48,8 @@ DiscriminativeParams exact_params(int levels) {
   DiscriminativeParams p;
   p.max_levels = levels;
   p.min_size = 8;
-  p.search_radius = 20;
+  p.search_radius = 20;  // one level
+  p.coarse_radius = 5;   // the coarsest of several
   p.scale_estimation = "none";
   p.redetection = false;
   // xi^1, xi^2 chosen so that the critical samples lie at distance 4 (level 1) and 3 (level 2)
@@ -68,7 +69,7 @@ TEST(MultiResolution, ThreeLevelsEvaluate371SamplesWhereOneLevelNeeds1245) {
   ASSERT_EQ(hierarchical.levels(), 3);
   const TrackState s = hierarchical.update(frame);
   ASSERT_EQ(s.levels.size(), 3u);
-  // coarsest first: radius 20 / 4 = 5 -> 69 samples; 44 rejected (floor(0.64 * 69)), the best
+  // coarsest first: radius 5 -> 69 samples; 44 rejected (floor(0.64 * 69)), the best
   // of them at distance 3 -> radius 6 -> 109 samples; 64 rejected, critical distance 4 -> radius 8.
   EXPECT_EQ(s.levels[0].level, 2);
   EXPECT_EQ(s.levels[0].evaluated, 69);
