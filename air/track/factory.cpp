@@ -9,6 +9,9 @@
 #include <stdexcept>
 
 #include "air/track/ct/ct.hpp"
+#ifdef AERIE_HAVE_IPSL
+#include "air/track/ipsl/ipsl.hpp"
+#endif
 #include "air/track/mil/mil.hpp"
 #include "air/track/pyramid/discriminative.hpp"
 
@@ -191,6 +194,14 @@ using Maker = std::function<std::unique_ptr<Tracker>(const util::Config&, uint64
 const std::vector<std::pair<std::string, Maker>>& registry() {
   static const std::vector<std::pair<std::string, Maker>> r = [] {
     std::vector<std::pair<std::string, Maker>> v;
+#ifdef AERIE_HAVE_IPSL
+    v.emplace_back("ipsl", [](const util::Config& c, uint64_t s) -> std::unique_ptr<Tracker> {
+      return std::make_unique<IpslTracker>(ipsl_params_from_config(c), s);
+    });
+    v.emplace_back("ipsl-mr", [](const util::Config& c, uint64_t s) -> std::unique_ptr<Tracker> {
+      return std::make_unique<HierarchicalIpslTracker>(hierarchical_ipsl_params_from_config(c), s);
+    });
+#endif
     v.emplace_back("ct", [](const util::Config& c, uint64_t s) { return make_ct("ct", c, s, single_resolution()); });
     v.emplace_back("amcmr-ct",
                    [](const util::Config& c, uint64_t s) { return make_ct("amcmr-ct", c, s, multi_resolution()); });

@@ -73,9 +73,12 @@ DiscriminativeTracker::DiscriminativeTracker(std::string name, DiscriminativePar
   if (!factory_) throw std::invalid_argument(name_ + ": no classifier factory");
 }
 
-cv::Size DiscriminativeTracker::box_at(int p, double scale) const {
-  const cv::Size t = levels_[p].template_size;
-  return {std::max(4, static_cast<int>(std::lround(t.width * scale))), std::max(4, static_cast<int>(std::lround(t.height * scale)))};
+double DiscriminativeTracker::largest_scale() const {
+  // The sample boxes must fit into the frame: a target that grows past it keeps the largest
+  // scale that fits (e.g. the helipad at the end of a descent).
+  const cv::Size2d t = levels_[0].template_size;
+  return std::min(params_.max_scale,
+                  0.95 * std::min((frame_size_.width - 2) / t.width, (frame_size_.height - 2) / t.height));
 }
 
 void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
@@ -168,8 +171,10 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
       }
     }
     const SampleSet samples = disc_samples(clamp_into(top_left(c, box), fp, bounds), radius, fp, bounds);
-    if (samples.empty())
-      throw std::runtime_error(name_ + ": the target box no longer fits into the image at level " + std::to_string(p));
+    if (samples.empty()) {  // the box does not fit into the searched region: no estimate
+      out.ok = false;
+      return out;
+    }
     L.classifier->score(L.ch, samples, scale_, scores);
     const size_t n = scores.size();
     const size_t best = std::max_element(scores.begin(), scores.end()) - scores.begin();
@@ -221,7 +226,7 @@ double DiscriminativeTracker::adapt_scale(const cv::Point2d& centre, const std::
   float best_score = -std::numeric_limits<float>::infinity();
   cv::Point2d best_centre = centre;
   for (double s : candidates) {
-    if (s < params_.min_scale || s > params_.max_scale) continue;
+    if (s < params_.min_scale || s > largest_scale()) continue;
     const cv::Size2d box = cv::Size2d(L.template_size) * s;
     const cv::Size fp = L.classifier->footprint(s);
     const SampleSet samples = disc_samples(top_left(centre, box), 1.5, fp, L.ch.roi());
@@ -270,6 +275,7 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
 
   TrackState state;
   state.initial_size = init_size_;
+  scale_ = std::min(scale_, largest_scale());
   std::vector<double> scales = {scale_};
   if (params_.scale_estimation == "classifier" || params_.scale_estimation == "both") {
     scales.push_back(scale_ / params_.scale_step);
@@ -281,7 +287,7 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
                                    {centre_.x - size.width / 2, centre_.y - size.height / 2, size.width, size.height});
     if (f.ok) {
       const double s = std::clamp(scale_ * std::clamp(f.ratio, 1 / params_.max_scale_change, params_.max_scale_change),
-                                  params_.min_scale, params_.max_scale);
+                                  params_.min_scale, largest_scale());
       if (params_.scale_estimation == "flow") scales[0] = scale_ = s; else scales.push_back(s);
     }
   }
@@ -302,6 +308,11 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   }
   Search s = search(lost_);
   state.levels = std::move(s.levels);
+  if (!s.ok) {
+    state.pose = {centre_.x, centre_.y, scale_, 0.0};
+    state.lost = true;
+    return state;
+  }
   const cv::Point2d previous = centre_;
   const double previous_scale = scale_;
   centre_ = s.centre;

@@ -98,6 +98,7 @@ class DiscriminativeTracker : public Tracker {
   // The multi-resolution search of one frame over given level images (exposed for tests):
   // returns the best sample centre at level 0 (full-resolution pixels) and fills stats.
   struct Search {
+    bool ok = true;  // false when no sample fits into the image
     cv::Point2d centre;
     float score = 0;        // best score at level 0
     double prominence = 0;  // (best - median) score per term over the coarsest level's search
@@ -112,7 +113,7 @@ class DiscriminativeTracker : public Tracker {
   };
 
   void build_pyramid(const cv::Mat& frame, const cv::Mat& gray, const cv::Rect& roi0);
-  cv::Size box_at(int p, double scale) const;
+  double largest_scale() const;
   Search search(bool scan);
   double adapt_scale(const cv::Point2d& centre, const std::vector<double>& candidates);
   void learn();
