@@ -261,11 +261,10 @@ bool Deputy::start(Command& c, int64_t now) {
 }
 
 void Deputy::signal_command(Command& c, int sig) {
-  const auto all = read_all_processes();
-  for (pid_t p : command_processes(c.pid, all))
+  kill(c.pid, sig);  // the command first, then what it started (found by a /proc scan)
+  for (pid_t p : command_processes(c.pid, read_all_processes()))
     if (std::find(c.stop_targets.begin(), c.stop_targets.end(), p) == c.stop_targets.end())
       c.stop_targets.push_back(p);
-  kill(c.pid, sig);
   for (pid_t p : c.stop_targets)
     if (p != c.pid) kill(p, sig);
 }

@@ -1,12 +1,13 @@
 #include "procman/proc_stats.hpp"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -15,18 +16,28 @@
 namespace aerie::procman {
 
 std::optional<ProcessSample> read_process(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string line;
-  if (!in || !std::getline(in, line)) return std::nullopt;
+  // Plain open/read: this runs for every process on every scan.
+  char path[64];
+  std::snprintf(path, sizeof path, "/proc/%d/stat", static_cast<int>(pid));
+  const int fd = open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  char buf[1024];
+  const ssize_t n = read(fd, buf, sizeof buf - 1);
+  close(fd);
+  if (n <= 0) return std::nullopt;
+  buf[n] = '\0';
   // The command name (field 2) is in parentheses and may contain spaces: parse after the last ')'.
-  const size_t rp = line.rfind(')');
-  if (rp == std::string::npos) return std::nullopt;
-  std::istringstream ss(line.substr(rp + 2));
-  std::string state;
-  long long f[21] = {0};  // fields 4..24 (ppid .. rss), see proc(5)
-  ss >> state;
-  for (long long& x : f) ss >> x;
-  if (!ss) return std::nullopt;
+  const char* p = std::strrchr(buf, ')');
+  if (!p || p[1] != ' ') return std::nullopt;
+  p += 2;
+  while (*p && *p != ' ') ++p;  // field 3, the state
+  long long f[21] = {0};        // fields 4..24 (ppid .. rss), see proc(5)
+  for (long long& x : f) {
+    char* end = nullptr;
+    x = std::strtoll(p, &end, 10);
+    if (end == p) return std::nullopt;
+    p = end;
+  }
   static const long page = sysconf(_SC_PAGESIZE);
   ProcessSample s;
   s.pid = pid;

@@ -147,6 +147,23 @@ EnterNamespace::~EnterNamespace() {
   close(original_);
 }
 
+RealtimePriority::RealtimePriority(int priority) {
+  sched_param old{};
+  old_policy_ = sched_getscheduler(0);
+  sched_getparam(0, &old);
+  old_priority_ = old.sched_priority;
+  sched_param sp{};
+  sp.sched_priority = priority;
+  ok_ = sched_setscheduler(0, SCHED_FIFO, &sp) == 0;
+}
+
+RealtimePriority::~RealtimePriority() {
+  if (!ok_) return;
+  sched_param sp{};
+  sp.sched_priority = old_priority_;
+  sched_setscheduler(0, old_policy_, &sp);
+}
+
 Process::Process(const std::vector<std::string>& argv, const std::string& log_path) : log_(log_path) {
   std::vector<std::string> args = argv;
   auto cargs = c_argv(args);

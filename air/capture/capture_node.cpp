@@ -39,6 +39,7 @@ CaptureConfig load_capture_config(const util::Config& c) {
   k.start = c.get<int64_t>("playback.start", k.start);
   k.stop = c.get<int64_t>("playback.stop", k.stop);
   k.duration_s = c.get("playback.duration", k.duration_s);
+  k.loop = c.get("playback.loop", k.loop);
   k.stamp = c.get("playback.stamp", k.stamp);
   k.max_consecutive_errors = c.get("playback.max_consecutive_errors", k.max_consecutive_errors);
   auto& ch = k.channels;
@@ -171,13 +172,16 @@ RunStats CaptureNode::run() {
   if (cfg_.start > 0) source_->seek(cfg_.start);
   std::optional<int64_t> first_utime;
   int64_t period_us = 0, last_utime = 0;
+  // Looping: each pass is shifted in time to follow the previous one by one frame interval.
+  int64_t loop_offset = 0, pass_first = 0, pass_last = 0, pass_published = 0;
   int consecutive_errors = 0;
   Frame frame;
   while (!bus::stop_requested()) {
     util::Stopwatch sw;
+    bool more = false;
     try {
-      if (!source_->next(frame)) break;
-      format_.apply(frame);
+      more = source_->next(frame) && !(cfg_.stop >= 0 && frame.index >= cfg_.stop);
+      if (more) format_.apply(frame);
       consecutive_errors = 0;
     } catch (const FrameError& e) {
       ++st.unreadable;
@@ -189,8 +193,18 @@ RunStats CaptureNode::run() {
       status.tick();
       continue;
     }
+    if (!more) {  // end of the source (or of the start..stop range)
+      if (!cfg_.loop || source_->live() || pass_published == 0) break;
+      loop_offset += pass_last - pass_first + std::max<int64_t>(period_us, 1);
+      pass_published = 0;
+      source_->seek(cfg_.start);
+      status.count("loops");
+      continue;
+    }
     status.time_ms("read_ms", sw.ms());
-    if (cfg_.stop >= 0 && frame.index >= cfg_.stop) break;
+    if (pass_published++ == 0) pass_first = frame.utime;
+    pass_last = frame.utime;
+    frame.utime += loop_offset;
     if (!first_utime) first_utime = frame.utime;
     if (cfg_.duration_s > 0 && frame.utime - *first_utime >= static_cast<int64_t>(cfg_.duration_s * 1e6)) break;
     if (st.published > 0) period_us = frame.utime - last_utime;

@@ -43,6 +43,7 @@ struct CaptureConfig {
   int64_t start = 0;             // first frame (index in the source)
   int64_t stop = -1;             // frame index to stop before (-1 = the end)
   double duration_s = 0;         // stop after this much source time (0 = no limit)
+  bool loop = false;             // recorded sources: start again at the end (times and seq go on)
   std::string stamp = "source";  // source: the frames' own times; wall: wall clock at publication
   int max_consecutive_errors = 50;  // unreadable frames in a row before giving up
   ChannelNames channels;

@@ -53,6 +53,8 @@ int main(int argc, char** argv) {
   option(app, ov, "--stop", [](CaptureConfig& c) -> auto& { return c.stop; }, "Stop before this frame (-1: the end)");
   option(app, ov, "--duration", [](CaptureConfig& c) -> auto& { return c.duration_s; },
          "Stop after this many seconds of source time (0: no limit)");
+  option(app, ov, "--loop", [](CaptureConfig& c) -> auto& { return c.loop; },
+         "true: play a recorded source again and again (times and seq go on)");
   option(app, ov, "--width", [](CaptureConfig& c) -> auto& { return c.output.width; },
          "Output width (with --height; the simulator renders at this size)");
   option(app, ov, "--height", [](CaptureConfig& c) -> auto& { return c.output.height; }, "Output height");
@@ -75,6 +77,8 @@ int main(int argc, char** argv) {
          "demo or survey");
   option(app, ov, "--sim-speed", [](CaptureConfig& c) -> auto& { return c.source.sim.speed; }, "m/s");
   option(app, ov, "--sim-loops", [](CaptureConfig& c) -> auto& { return c.source.sim.loops; }, "survey loops");
+  option(app, ov, "--sim-start-utime", [](CaptureConfig& c) -> auto& { return c.source.sim.start_utime; },
+         "utime of the first simulated frame (-1: the wall clock at start)");
   option(app, ov, "--sim-noise", [](CaptureConfig& c) -> auto& { return c.source.sim.noise_sigma; },
          "image noise sigma, gray levels");
   CLI11_PARSE(app, argc, argv);

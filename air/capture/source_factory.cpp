@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "air/capture/image_folder_source.hpp"
+#include "air/capture/sim_source.hpp"
 #include "air/capture/stereo_sequence_source.hpp"
 #include "air/capture/video_source.hpp"
 
@@ -12,6 +13,7 @@ std::unique_ptr<FrameSource> make_source(const SourceOptions& o) {
   auto need_path = [&](const char* what) {
     if (o.path.empty()) throw std::invalid_argument("source '" + o.type + "' needs a path (" + what + ")");
   };
+  if (o.type == "sim") return std::make_unique<SimSource>(o.sim, o.width, o.height, o.color, o.fps);
   if (o.type == "folder") {
     need_path("image folder");
     return std::make_unique<ImageFolderSource>(o.path, o.timestamps, o.fps, o.color);

@@ -10,7 +10,8 @@ namespace aerie::capture {
 
 struct SimSourceOptions {
   uint64_t seed = 1;                  // world texture/layout seed
-  std::string trajectory = "demo";    // "demo" (take-off, survey, approach, descent) or "survey"
+  std::string trajectory = "demo";    // "demo" (take-off, survey, approach, descent), "survey" or
+                                      // "landing" (approach + descent, camera looking down)
   double speed = 0.8;                 // m/s along the trajectory
   int loops = 2;                      // survey: number of loops
   double noise_sigma = 0.0;           // image noise, gray levels

@@ -1,8 +1,11 @@
 // Simulator speed: stereo frames/s on one thread at 376x240 and 752x480 along the demo
 // flight, world build time, intruder-scene frames/s. Prints a table and writes
-// <out>/sim_bench.json and <out>/sim_bench.csv.
+// <out>/sim_bench.json, <out>/sim_bench.csv and <out>/sim_frames.png (example frames with
+// their ground truth: left, right, depth; landing frame and intruder frame with their boxes).
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -19,9 +22,9 @@
 
 namespace {
 
-double thread_cpu_seconds() {
+double process_cpu_seconds() {
   rusage u{};
-  getrusage(RUSAGE_THREAD, &u);
+  getrusage(RUSAGE_SELF, &u);  // all threads of the process
   return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
@@ -36,10 +39,10 @@ struct Timing {
 template <typename F>
 Timing measure(const std::string& what, int frames, F&& body) {
   const auto w0 = std::chrono::steady_clock::now();
-  const double c0 = thread_cpu_seconds();
+  const double c0 = process_cpu_seconds();
   body();
   Timing t{what, frames, std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count(),
-           thread_cpu_seconds() - c0};
+           process_cpu_seconds() - c0};
   return t;
 }
 
@@ -49,6 +52,63 @@ std::string load_average() {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.2f %.2f %.2f", l[0], l[1], l[2]);
   return buf;
+}
+
+cv::Mat to_bgr(const cv::Mat& gray) {
+  cv::Mat bgr;
+  cv::cvtColor(gray, bgr, cv::COLOR_GRAY2BGR);
+  return bgr;
+}
+
+// A mosaic of example frames (each scaled to 376x240) with their ground truth drawn.
+cv::Mat example_frames(const aerie::sim::World& world) {
+  using namespace aerie::sim;
+  const cv::Size tile(376, 240);
+  std::vector<cv::Mat> tiles;
+  auto add = [&](const cv::Mat& img) {
+    cv::Mat t;
+    cv::resize(img, t, tile, 0, 0, cv::INTER_AREA);
+    tiles.push_back(t);
+  };
+  const StereoSimulation demo(world, RigConfig{}, Trajectory::demo_flight(world));
+  for (int k : {150, 500}) {
+    const StereoFrame f = demo.frame(k);
+    add(to_bgr(f.left));
+    add(to_bgr(f.right));
+    cv::Mat depth8, depth_color;
+    f.depth.convertTo(depth8, CV_8U, 255.0 / 10.0);  // 0..10 m
+    cv::applyColorMap(depth8, depth_color, cv::COLORMAP_TURBO);
+    add(depth_color);
+  }
+  const StereoSimulation landing = landing_simulation(world);
+  for (int k = 0; k < landing.frame_count(); ++k) {
+    const StereoFrame f = landing.frame(k);
+    if (!f.target_visible || f.target_box.width < 90) continue;
+    cv::Mat img = to_bgr(f.left);
+    for (int i = 0; i < 4; ++i) cv::line(img, f.target_corners[i], f.target_corners[(i + 1) % 4], {0, 0, 255}, 1, cv::LINE_AA);
+    cv::rectangle(img, f.target_box, {0, 255, 0}, 1);
+    add(img);
+    break;
+  }
+  IntruderConfig ic;
+  ic.frames = 200;
+  const IntruderScene intruder(ic);
+  for (int k : {0, 199}) {
+    const MonoFrame f = intruder.frame(k);
+    cv::Mat img = to_bgr(f.image);
+    cv::rectangle(img, f.target_box, {0, 255, 0}, 2);
+    add(img);
+  }
+  while (tiles.size() % 3) tiles.push_back(cv::Mat::zeros(tile, CV_8UC3));
+  std::vector<cv::Mat> rows;
+  for (size_t i = 0; i < tiles.size(); i += 3) {
+    cv::Mat row;
+    cv::hconcat(std::vector<cv::Mat>(tiles.begin() + i, tiles.begin() + i + 3), row);
+    rows.push_back(row);
+  }
+  cv::Mat out;
+  cv::vconcat(rows, out);
+  return out;
 }
 
 }  // namespace
@@ -117,6 +177,7 @@ int main(int argc, char** argv) {
          << "}" << (i + 1 < results.size() ? "," : "") << "\n";
   }
   json << "  ]\n}\n";
-  std::printf("wrote %s/sim_bench.json and sim_bench.csv\n", out.c_str());
+  cv::imwrite(out + "/sim_frames.png", example_frames(world));
+  std::printf("wrote %s/sim_bench.json, sim_bench.csv and sim_frames.png\n", out.c_str());
   return 0;
 }

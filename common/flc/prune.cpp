@@ -9,10 +9,16 @@ namespace aerie::flc {
 namespace {
 
 // For each set of v, the index (in v) of the set it is merged into.
-std::vector<int> merge_map(const Variable& v, double fraction) {
+std::vector<int> merge_map(const Variable& v, const PruneOptions& options) {
   const int n = v.size();
-  const double gap = fraction * (v.max - v.min) / std::max(1, n - 1);
   std::vector<int> keep(static_cast<size_t>(n));
+  const auto& only = options.variables;
+  if (!only.empty() && std::find(only.begin(), only.end(), v.name) == only.end()) {
+    for (int k = 0; k < n; ++k) keep[static_cast<size_t>(k)] = k;
+    return keep;
+  }
+  const double fraction = options.overlap_fraction;
+  const double gap = fraction * (v.max - v.min) / std::max(1, n - 1);
   for (int first = 0; first < n;) {
     int last = first;
     while (last + 1 < n && v.positions[last + 1] - v.positions[last] < gap) ++last;
@@ -56,10 +62,10 @@ FlcSpec prune(const FlcSpec& spec, const PruneOptions& options, PruneReport* rep
   FlcSpec out = spec;
   std::array<std::vector<int>, kInputs> in_keep, in_index;
   for (int i = 0; i < kInputs; ++i) {
-    in_keep[i] = merge_map(spec.inputs[i], options.overlap_fraction);
+    in_keep[i] = merge_map(spec.inputs[i], options);
     in_index[i] = apply(out.inputs[i], in_keep[i], rep);
   }
-  const auto out_index = apply(out.output, merge_map(spec.output, options.overlap_fraction), rep);
+  const auto out_index = apply(out.output, merge_map(spec.output, options), rep);
   out.rules.clear();
   for (const Rule& r : spec.rules) {
     bool removed = false;  // the rule of a removed input set goes with it

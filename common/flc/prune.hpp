@@ -14,6 +14,8 @@ struct PruneOptions {
   // Two adjacent sets overlap when their peaks are closer than this fraction of the
   // variable's even spacing (range / (sets - 1)).
   double overlap_fraction = 0.1;
+  // Variables whose sets may be merged; empty = all four.
+  std::vector<std::string> variables;
 };
 
 struct PruneReport {

@@ -122,6 +122,10 @@ IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
   cv::rectangle(paint, to_sprite({-0.43, 0.17}), to_sprite({-0.39, -0.17}), cv::Scalar(40, 40, 40), cv::FILLED);
   cv::circle(paint, to_sprite({0.36, 0.0}), 12, cv::Scalar(30, 30, 30), cv::FILLED, cv::LINE_AA);  // cockpit
   sprite_ = paint;
+  if (!cfg.color) {  // compose in the output format
+    cv::cvtColor(sprite_, sprite_, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(sky_, sky_, cv::COLOR_BGR2GRAY);
+  }
 
   // Motion: crossing the image (direction from the seed) on a gentle arc, approaching
   // (growing), with a slow bank.
@@ -159,31 +163,6 @@ MonoFrame IntruderScene::frame(int k) const {
   // image = [c -sn; sn c] (p - ref) + t   (counter-clockwise on screen is -angle in y-down)
   const cv::Matx23d M(c, sn, t.x - c * sprite_ref_.x - sn * sprite_ref_.y,
                       -sn, c, t.y + sn * sprite_ref_.x - c * sprite_ref_.y);
-  cv::Mat plane, alpha;
-  cv::warpAffine(sprite_, plane, M, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-  cv::warpAffine(sprite_alpha_, alpha, M, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-  for (int y = 0; y < size.height && config_.draw_target; ++y) {
-    auto* dst = img.ptr<cv::Vec3f>(y);
-    const auto* src = plane.ptr<cv::Vec3f>(y);
-    const float* a = alpha.ptr<float>(y);
-    for (int x = 0; x < size.width; ++x)
-      if (a[x] > 0.f) dst[x] = (1.f - a[x]) * dst[x] + a[x] * src[x];
-  }
-  MonoFrame f;
-  f.seq = k;
-  f.utime = config_.start_utime + static_cast<int64_t>(std::llround(k / config_.rate_hz * 1e6));
-  if (config_.color) {
-    f.image = img;
-  } else {
-    cv::cvtColor(img, f.image, cv::COLOR_BGR2GRAY);
-  }
-  if (config_.noise_sigma > 0) {
-    cv::Mat noise(f.image.size(), f.image.type());
-    cv::RNG rng(mix_seed(config_.seed, 1000 + static_cast<uint64_t>(k)));
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, config_.noise_sigma);
-    f.image += noise;
-  }
-  f.image.convertTo(f.image, config_.color ? CV_8UC3 : CV_8UC1);
   // Ground truth: bounding box of the transformed silhouette outline.
   double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
   for (const auto& p : outline_) {
@@ -193,6 +172,36 @@ MonoFrame IntruderScene::frame(int k) const {
     y0 = std::min(y0, v);
     y1 = std::max(y1, v);
   }
+  // Warp the sprite only into the region it covers and blend it by its alpha.
+  const cv::Rect roi = cv::Rect(cvFloor(x0) - 2, cvFloor(y0) - 2, cvCeil(x1 - x0) + 5, cvCeil(y1 - y0) + 5) &
+                       cv::Rect(0, 0, size.width, size.height);
+  if (config_.draw_target && roi.area() > 0) {
+    cv::Matx23d Mr = M;
+    Mr(0, 2) -= roi.x;
+    Mr(1, 2) -= roi.y;
+    cv::Mat plane, alpha;
+    cv::warpAffine(sprite_, plane, Mr, roi.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    cv::warpAffine(sprite_alpha_, alpha, Mr, roi.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    cv::Mat dst = img(roi);
+    const int cn = img.channels();
+    for (int y = 0; y < roi.height; ++y) {
+      float* d = dst.ptr<float>(y);
+      const float* src = plane.ptr<float>(y);
+      const float* a = alpha.ptr<float>(y);
+      for (int x = 0; x < roi.width; ++x)
+        for (int ch = 0; ch < cn; ++ch) d[cn * x + ch] += a[x] * (src[cn * x + ch] - d[cn * x + ch]);
+    }
+  }
+  MonoFrame f;
+  f.seq = k;
+  f.utime = config_.start_utime + static_cast<int64_t>(std::llround(k / config_.rate_hz * 1e6));
+  if (config_.noise_sigma > 0) {
+    cv::Mat noise(img.size(), img.type());
+    cv::RNG rng(mix_seed(config_.seed, 1000 + static_cast<uint64_t>(k)));
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, config_.noise_sigma);
+    img += noise;
+  }
+  img.convertTo(f.image, config_.color ? CV_8UC3 : CV_8UC1);
   f.target_box = cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
   f.target_visible = x0 >= 0 && y0 >= 0 && x1 <= size.width && y1 <= size.height;
   f.target_center = t;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace aerie::sim {
 
@@ -24,8 +25,13 @@ StereoFrame StereoSimulation::frame(int k) const {
   if (k < 0 || k >= frame_count_)
     throw std::out_of_range("sim::StereoSimulation::frame: " + std::to_string(k) + " not in [0, " +
                             std::to_string(frame_count_) + ")");
-  const geometry::SE3 T_world_body = trajectory_.pose(time_of(k));
-  StereoFrame f = renderer_.render(T_world_body * T_body_left_, utime_of(k), k);
+  const double t = time_of(k);
+  const geometry::SE3 T_world_body = trajectory_.pose(t);
+  std::vector<geometry::SE3> blur;
+  const int n = renderer_.rig().motion_blur_samples;
+  for (int i = 0; i < n && n > 1; ++i)  // poses spread over [t - exposure, t]
+    blur.push_back(trajectory_.pose(t - renderer_.rig().exposure_time * (n - 1 - i) / (n - 1)) * T_body_left_);
+  StereoFrame f = renderer_.render(T_world_body * T_body_left_, utime_of(k), k, blur);
   f.T_world_body = T_world_body;
   return f;
 }

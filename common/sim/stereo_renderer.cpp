@@ -72,6 +72,8 @@ StereoRenderer::StereoRenderer(const World& world, const RigConfig& rig) : world
   check(rig.illumination_amplitude >= 0 && rig.illumination_amplitude < 1,
         "illumination_amplitude must be in [0, 1)");
   check(rig.illumination_period > 0, "illumination_period must be > 0");
+  check(rig.motion_blur_samples >= 0 && rig.motion_blur_samples <= 64, "motion_blur_samples must be in [0, 64]");
+  check(rig.exposure_time > 0, "exposure_time must be > 0");
   K_.width = rig.width;
   K_.height = rig.height;
   K_.fx = 0.5 * rig.width / std::tan(0.5 * rig.hfov_deg * kPi / 180.0);
@@ -163,87 +165,87 @@ void StereoRenderer::render_view(const geometry::SE3& T_world_cam, cv::Mat& radi
   const float cx = static_cast<float>(K_.cx), cy = static_cast<float>(K_.cy);
   const float nan = std::numeric_limits<float>::quiet_NaN();
 
-  std::vector<const Box*> row_boxes;
-  row_boxes.reserve(boxes.size());
-  for (int v = 0; v < H; ++v) {
-    row_boxes.clear();
-    for (const auto& b : boxes)
-      if (v >= b.v0 && v <= b.v1) row_boxes.push_back(&b);
-    const float y = (static_cast<float>(v) - cy) * inv_fy;
-    float* out = radiance.ptr<float>(v);
-    float* zrow = depth ? depth->ptr<float>(v) : nullptr;
-    for (int u = 0; u < W; ++u) {
-      const float x = (static_cast<float>(u) - cx) * inv_fx;
-      const float d[3] = {r2[0] + x * r0[0] + y * r1[0], r2[1] + x * r0[1] + y * r1[1], r2[2] + x * r0[2] + y * r1[2]};
-      const float inv[3] = {1.f / d[0], 1.f / d[1], 1.f / d[2]};
-      // Room: the exit face.
-      float t = std::numeric_limits<float>::infinity();
-      int surface = -1;
-      for (int a = 0; a < 3; ++a) {
-        const bool pos = d[a] > 0.f;
-        const float ta = (pos ? room_hi[a] : room_lo[a]) * inv[a];
-        if (ta < t) {
-          t = ta;
-          surface = 2 * a + pos;
-        }
-      }
-      // Obstacles: the entry face of the nearest one.
-      for (const Box* b : row_boxes) {
-        if (u < b->u0 || u > b->u1) continue;
-        float t_near = -std::numeric_limits<float>::infinity(), t_far = std::numeric_limits<float>::infinity();
-        int axis = 0;
+  // Rows are independent: stripes may run in parallel (cv::setNumThreads(1) for one core);
+  // the result does not depend on the split.
+  cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& rows) {
+    std::vector<const Box*> row_boxes;
+    row_boxes.reserve(boxes.size());
+    for (int v = rows.start; v < rows.end; ++v) {
+      row_boxes.clear();
+      for (const auto& b : boxes)
+        if (v >= b.v0 && v <= b.v1) row_boxes.push_back(&b);
+      const float y = (static_cast<float>(v) - cy) * inv_fy;
+      float* out = radiance.ptr<float>(v);
+      float* zrow = depth ? depth->ptr<float>(v) : nullptr;
+      for (int u = 0; u < W; ++u) {
+        const float x = (static_cast<float>(u) - cx) * inv_fx;
+        const float d[3] = {r2[0] + x * r0[0] + y * r1[0], r2[1] + x * r0[1] + y * r1[1], r2[2] + x * r0[2] + y * r1[2]};
+        const float inv[3] = {1.f / d[0], 1.f / d[1], 1.f / d[2]};
+        // Room: the exit face.
+        float t = std::numeric_limits<float>::infinity();
+        int surface = -1;
         for (int a = 0; a < 3; ++a) {
-          const float t1 = b->lo[a] * inv[a], t2 = b->hi[a] * inv[a];
-          const float tn = min_f(t1, t2), tf = max_f(t1, t2);
-          if (tn > t_near) {
-            t_near = tn;
-            axis = a;
+          const bool pos = d[a] > 0.f;
+          const float ta = (pos ? room_hi[a] : room_lo[a]) * inv[a];
+          if (ta < t) {
+            t = ta;
+            surface = 2 * a + pos;
           }
-          t_far = min_f(t_far, tf);
         }
-        if (t_near <= t_far && t_near > 0.f && t_near < t) {
-          t = t_near;
-          surface = 6 + 6 * b->index + 2 * axis + (d[axis] > 0.f ? 0 : 1);
+        // Obstacles: the entry face of the nearest one.
+        for (const Box* b : row_boxes) {
+          if (u < b->u0 || u > b->u1) continue;
+          // Slab test, branch-free; the entry axis is only worked out for a nearer hit.
+          const float ax1 = b->lo[0] * inv[0], ax2 = b->hi[0] * inv[0];
+          const float ay1 = b->lo[1] * inv[1], ay2 = b->hi[1] * inv[1];
+          const float az1 = b->lo[2] * inv[2], az2 = b->hi[2] * inv[2];
+          const float nx = min_f(ax1, ax2), ny = min_f(ay1, ay2), nz = min_f(az1, az2);
+          const float t_near = max_f(nx, max_f(ny, nz));
+          const float t_far = min_f(max_f(ax1, ax2), min_f(max_f(ay1, ay2), max_f(az1, az2)));
+          if (t_near <= t_far && t_near > 0.f && t_near < t) {
+            t = t_near;
+            const int axis = t_near == nx ? 0 : (t_near == ny ? 1 : 2);
+            surface = 6 + 6 * b->index + 2 * axis + (d[axis] > 0.f ? 0 : 1);
+          }
         }
-      }
-      if (surface < 0 || !std::isfinite(t)) {
+        if (surface < 0 || !std::isfinite(t)) {
+          if (color) {
+            out[3 * u] = out[3 * u + 1] = out[3 * u + 2] = 0.f;
+          } else {
+            out[u] = 0.f;
+          }
+          if (zrow) zrow[u] = nan;
+          continue;
+        }
+        const Surface& s = surfaces[surface];
+        const MipTexture& tex = textures[surface];
+        const int k = s.axis;
+        // Texture coordinates (level-0 texels, centres on integers).
+        const float density = tex.texels_per_metre();
+        const float pu = of[s.u_axis] + t * d[s.u_axis], pv = of[s.v_axis] + t * d[s.v_axis];
+        const float tu = (pu - static_cast<float>(s.u0)) * density - 0.5f;
+        const float tv = static_cast<float>(s.v_sign) * (pv - static_cast<float>(s.v0)) * density - 0.5f;
+        // Footprint: dP/du = t (du - d du_k / d_k) (plane x_k = const), same for v.
+        // Only the two in-plane axes: the k component is zero by construction.
+        const float ku = du[k] * inv[k], kv = dv[k] * inv[k];
+        const int a1 = s.u_axis, a2 = s.v_axis;
+        const float eu1 = du[a1] - d[a1] * ku, eu2 = du[a2] - d[a2] * ku;
+        const float ev1 = dv[a1] - d[a1] * kv, ev2 = dv[a2] - d[a2] * kv;
+        const float fu2 = eu1 * eu1 + eu2 * eu2, fv2 = ev1 * ev1 + ev2 * ev2;
+        const float f2 = max_f(fu2, fv2) * t * t * density * density;
+        const float lod = f2 > 1.f ? 0.5f * fast_log2(f2) : 0.f;
+        const float value = s.shade * tex.trilinear(tu, tv, lod);
         if (color) {
-          out[3 * u] = out[3 * u + 1] = out[3 * u + 2] = 0.f;
+          out[3 * u] = value * s.tint[0];
+          out[3 * u + 1] = value * s.tint[1];
+          out[3 * u + 2] = value * s.tint[2];
         } else {
-          out[u] = 0.f;
+          out[u] = value;
         }
-        if (zrow) zrow[u] = nan;
-        continue;
+        if (zrow) zrow[u] = t;
       }
-      const Surface& s = surfaces[surface];
-      const MipTexture& tex = textures[surface];
-      const int k = s.axis;
-      // Texture coordinates (level-0 texels, centres on integers).
-      const float density = tex.texels_per_metre();
-      const float pu = of[s.u_axis] + t * d[s.u_axis], pv = of[s.v_axis] + t * d[s.v_axis];
-      const float tu = (pu - static_cast<float>(s.u0)) * density - 0.5f;
-      const float tv = static_cast<float>(s.v_sign) * (pv - static_cast<float>(s.v0)) * density - 0.5f;
-      // Footprint: dP/du = t (du - d du_k / d_k) (plane x_k = const), same for v.
-      const float ku = du[k] * inv[k], kv = dv[k] * inv[k];
-      float fu2 = 0.f, fv2 = 0.f;
-      for (int a = 0; a < 3; ++a) {
-        const float eu = du[a] - d[a] * ku, ev = dv[a] - d[a] * kv;
-        fu2 += eu * eu;
-        fv2 += ev * ev;
-      }
-      const float f2 = max_f(fu2, fv2) * t * t * density * density;
-      const float lod = f2 > 1.f ? 0.5f * fast_log2(f2) : 0.f;
-      const float value = s.shade * tex.trilinear(tu, tv, lod);
-      if (color) {
-        out[3 * u] = value * s.tint[0];
-        out[3 * u + 1] = value * s.tint[1];
-        out[3 * u + 2] = value * s.tint[2];
-      } else {
-        out[u] = value;
-      }
-      if (zrow) zrow[u] = t;
     }
-  }
+  });
 }
 
 void StereoRenderer::project_helipad(const geometry::SE3& T_world_left, StereoFrame& f) const {
@@ -280,15 +282,32 @@ void StereoRenderer::project_helipad(const geometry::SE3& T_world_left, StereoFr
     f.target_box = cv::Rect2d();
 }
 
-StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq) const {
+StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
+                                   const std::vector<geometry::SE3>& blur_poses) const {
   StereoFrame f;
   f.utime = utime;
   f.seq = seq;
   f.T_world_left = T_world_left;
   cv::Mat rad_left, rad_right;
-  render_view(T_world_left, rad_left, &f.depth);
   const geometry::SE3 T_left_right(Eigen::Quaterniond::Identity(), Eigen::Vector3d(rig_.baseline, 0, 0));
-  render_view(T_world_left * T_left_right, rad_right, nullptr);
+  if (blur_poses.empty()) {
+    render_view(T_world_left, rad_left, &f.depth);
+    render_view(T_world_left * T_left_right, rad_right, nullptr);
+  } else {
+    // Motion blur: the sensor integrates the radiance over the exposure.
+    render_view(T_world_left, rad_left, &f.depth);
+    rad_left.setTo(0);
+    rad_right = cv::Mat::zeros(rad_left.size(), rad_left.type());
+    cv::Mat l, r;
+    for (const auto& T : blur_poses) {
+      render_view(T, l, nullptr);
+      render_view(T * T_left_right, r, nullptr);
+      rad_left += l;
+      rad_right += r;
+    }
+    rad_left /= static_cast<double>(blur_poses.size());
+    rad_right /= static_cast<double>(blur_poses.size());
+  }
 
   // Photometry: exposure, slow illumination change, right camera gain, noise.
   const double t = utime * 1e-6;

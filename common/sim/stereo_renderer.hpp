@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "common/camera/camera_model.hpp"
 #include "common/geometry/se3.hpp"
@@ -27,6 +28,8 @@ struct RigConfig {
   double illumination_amplitude = 0.0;  // relative gain swing over time (0 = constant light)
   double illumination_period = 10.0;    // s, period of that swing
   double right_gain = 1.0;         // extra gain of the right camera (photometric mismatch)
+  int motion_blur_samples = 0;     // > 1: average this many poses over the exposure (0 = off)
+  double exposure_time = 0.01;     // s, the shutter time motion blur spans (ending at the frame time)
   bool disparity = false;          // also output the exact left disparity map
   uint64_t noise_seed = 1;         // seed of the image noise (frame seq is mixed in)
 
@@ -76,8 +79,11 @@ class StereoRenderer {
   const World& world() const { return world_; }
 
   // Renders both views for the given left camera pose. utime drives the illumination
-  // change, seq the image noise; both are copied into the frame.
-  StereoFrame render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq) const;
+  // change, seq the image noise; both are copied into the frame. With blur_poses (left
+  // camera poses spread over the exposure) the images are their average (motion blur);
+  // depth and ground truth stay those of T_world_left.
+  StereoFrame render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
+                     const std::vector<geometry::SE3>& blur_poses = {}) const;
 
   // One view into a float radiance image (0..255 scale, before gain, noise and
   // quantisation) and optionally its depth; the building block of render().

@@ -17,21 +17,28 @@ uint64_t mix_seed(uint64_t seed, uint64_t stream) {
 MipTexture::MipTexture(const cv::Mat& level0, double texels_per_metre)
     : density_(static_cast<float>(texels_per_metre)) {
   CV_Assert(level0.type() == CV_8UC1 && !level0.empty());
-  levels_.push_back(level0);
-  scale_.push_back(1.f);
-  while (levels_.back().cols > 1 || levels_.back().rows > 1) {
-    const cv::Mat& prev = levels_.back();
+  std::vector<cv::Mat> pyramid{level0};
+  while (pyramid.back().cols > 1 || pyramid.back().rows > 1) {
+    const cv::Mat& prev = pyramid.back();
     cv::Mat next;
     if (prev.cols >= 2 && prev.rows >= 2) {
       cv::pyrDown(prev, next);
     } else {
       // pyrDown needs 2x2; keep halving the long side by averaging.
-      cv::resize(prev, next, cv::Size((prev.cols + 1) / 2, (prev.rows + 1) / 2), 0, 0,
-                 cv::INTER_AREA);
+      cv::resize(prev, next, cv::Size((prev.cols + 1) / 2, (prev.rows + 1) / 2), 0, 0, cv::INTER_AREA);
     }
-    levels_.push_back(next);
-    scale_.push_back(scale_.back() * 0.5f);
+    pyramid.push_back(next);
   }
+  float scale = 1.f;
+  for (const cv::Mat& m : pyramid) {
+    cv::Mat padded;
+    cv::copyMakeBorder(m, padded, 0, 1, 0, 1, cv::BORDER_REPLICATE);
+    padded_.push_back(padded);
+    levels_.push_back({padded.data, static_cast<ptrdiff_t>(padded.step[0]), m.cols, m.rows,
+                       static_cast<float>(m.cols - 1), static_cast<float>(m.rows - 1), scale});
+    scale *= 0.5f;
+  }
+  last_ = static_cast<int>(levels_.size()) - 1;
 }
 
 cv::Mat value_noise(cv::Size size, double cell, int octaves, double gain, uint64_t seed) {
@@ -83,10 +90,10 @@ void scatter_marks(cv::Mat& img, double density, double per_m2, cv::RNG& rng, do
   for (int i = 0; i < n; ++i) {
     const double size = density * std::exp(rng.uniform(std::log(0.01), std::log(0.12)));
     const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), rng.uniform(0.0, 1.0 * img.rows));
-    const double mean = cv::mean(img(cv::Rect(std::clamp(static_cast<int>(c.x), 0, img.cols - 1),
-                                             std::clamp(static_cast<int>(c.y), 0, img.rows - 1), 1, 1)))[0];
+    const float below = img.at<float>(std::min(static_cast<int>(c.y), img.rows - 1),
+                                      std::min(static_cast<int>(c.x), img.cols - 1));
     // Dark on bright, bright on dark.
-    const double shade = mean > 0.5 ? rng.uniform(0.0, 0.5 - 0.3 * contrast) : rng.uniform(0.5 + 0.3 * contrast, 1.0);
+    const double shade = below > 0.5f ? rng.uniform(0.0, 0.5 - 0.3 * contrast) : rng.uniform(0.5 + 0.3 * contrast, 1.0);
     const cv::Scalar col(shade);
     auto P = [&](double x, double y) { return cv::Point(cvRound(x * sub), cvRound(y * sub)); };
     switch (rng.uniform(0, 5)) {

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -17,41 +18,47 @@ class MipTexture {
   MipTexture(const cv::Mat& level0, double texels_per_metre);
 
   int levels() const { return static_cast<int>(levels_.size()); }
-  const cv::Mat& level(int k) const { return levels_[k]; }
+  // Level k without its replicated border.
+  cv::Mat level(int k) const { return padded_[k](cv::Rect(0, 0, levels_[k].width, levels_[k].height)); }
   float texels_per_metre() const { return density_; }
 
   // Bilinear sample of level k at level-0 texel coordinates (u, v) (texel centres on
   // integers); clamps at the border.
   float bilinear(int k, float u, float v) const {
-    const cv::Mat& m = levels_[k];
-    const float s = scale_[k];
-    float x = u * s, y = v * s;
-    const float xmax = static_cast<float>(m.cols - 1), ymax = static_cast<float>(m.rows - 1);
-    x = x < 0.f ? 0.f : (x > xmax ? xmax : x);
-    y = y < 0.f ? 0.f : (y > ymax ? ymax : y);
+    const Level& l = levels_[k];
+    float x = u * l.scale, y = v * l.scale;
+    x = x < 0.f ? 0.f : (x > l.x_max ? l.x_max : x);
+    y = y < 0.f ? 0.f : (y > l.y_max ? l.y_max : y);
     const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-    const int x1 = x0 + (x0 + 1 < m.cols), y1 = y0 + (y0 + 1 < m.rows);
-    const float fx = x - x0, fy = y - y0;
-    const uint8_t* r0 = m.ptr<uint8_t>(y0);
-    const uint8_t* r1 = m.ptr<uint8_t>(y1);
-    const float a = r0[x0] + fx * (r0[x1] - r0[x0]);
-    const float b = r1[x0] + fx * (r1[x1] - r1[x0]);
+    const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+    // The replicated right/bottom border makes x0 + 1 and y0 + 1 always valid.
+    const uint8_t* r0 = l.data + static_cast<ptrdiff_t>(y0) * l.stride + x0;
+    const uint8_t* r1 = r0 + l.stride;
+    const float a = r0[0] + fx * static_cast<float>(r0[1] - r0[0]);
+    const float b = r1[0] + fx * static_cast<float>(r1[1] - r1[0]);
     return a + fy * (b - a);
   }
   // Trilinear sample: lod = log2(texels per pixel footprint).
   float trilinear(float u, float v, float lod) const {
     if (lod <= 0.f) return bilinear(0, u, v);
-    const int last = static_cast<int>(levels_.size()) - 1;
     const int k = static_cast<int>(lod);
-    if (k >= last) return bilinear(last, u, v);
+    if (k >= last_) return bilinear(last_, u, v);
     const float f = lod - static_cast<float>(k);
     const float a = bilinear(k, u, v);
     return a + f * (bilinear(k + 1, u, v) - a);
   }
 
  private:
-  std::vector<cv::Mat> levels_;  // CV_8UC1
-  std::vector<float> scale_;     // 2^-k
+  struct Level {
+    const uint8_t* data;
+    ptrdiff_t stride;
+    int width, height;
+    float x_max, y_max;  // width - 1, height - 1
+    float scale;         // 2^-k
+  };
+  std::vector<cv::Mat> padded_;  // CV_8UC1, one replicated column/row right and below
+  std::vector<Level> levels_;
+  int last_ = 0;
   float density_ = 1.f;
 };
 

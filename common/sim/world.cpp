@@ -124,6 +124,41 @@ void paint_helipad(cv::Mat& tex, const Surface& floor, const Helipad& pad, doubl
   }
 }
 
+// Diffuse light baked into a surface's texture (view-independent, so both cameras agree):
+// ambient plus Lambertian lamps with inverse-square falloff and hard shadows of the
+// obstacles, evaluated every 10 cm and interpolated (which softens the shadow edges).
+void bake_lighting(const World& w, const Surface& s, const std::vector<Eigen::Vector3d>& lamps, cv::Mat& tex) {
+  constexpr double kStep = 0.1, kAmbient = 0.3, kMax = 1.05;
+  const double power = 0.25 * w.config().room_z * w.config().room_z;
+  const int nu = std::max(2, static_cast<int>(std::ceil(s.u_len / kStep)) + 1);
+  const int nv = std::max(2, static_cast<int>(std::ceil(s.v_len / kStep)) + 1);
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  n[s.axis] = s.normal_sign;
+  cv::Mat light(nv, nu, CV_32F);
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      Eigen::Vector3d p;
+      p[s.axis] = s.offset;
+      p[s.u_axis] = s.u0 + s.u_len * i / (nu - 1);
+      p[s.v_axis] = s.v0 + s.v_sign * s.v_len * j / (nv - 1);
+      double e = kAmbient;
+      for (const auto& lamp : lamps) {
+        const Eigen::Vector3d l = lamp - p;
+        const double r2 = l.squaredNorm(), cos_in = n.dot(l) / std::sqrt(r2);
+        if (cos_in <= 0) continue;
+        if (w.raycast(p + 1e-6 * n, l, 1.0 - 1e-6)) continue;  // in the shadow of an obstacle
+        e += power * cos_in / r2;
+      }
+      light.at<float>(j, i) = static_cast<float>(std::min(e, kMax));
+    }
+  cv::Mat up;
+  cv::resize(light, up, tex.size(), 0, 0, cv::INTER_LINEAR);
+  cv::Mat lit;
+  tex.convertTo(lit, CV_32F);
+  lit = lit.mul(up);
+  lit.convertTo(tex, CV_8U);
+}
+
 }  // namespace
 
 std::array<Eigen::Vector3d, 4> Helipad::corners() const {
@@ -211,40 +246,29 @@ World World::room(const WorldConfig& cfg) {
     if (ok) w.obstacles_.push_back(o);
   }
 
-  // Surfaces and their textures.
-  auto textures = std::make_shared<Textures>();
+  // Surfaces and their textures (level 0 first; lighting and the helipad go on top).
   const double density = cfg.texels_per_metre;
+  std::vector<cv::Mat> images;
   auto add = [&](Surface s, Material m, uint64_t stream) {
-    const cv::Mat tex = make_texture(m, s.u_len, s.v_len, density, mix_seed(cfg.seed, stream));
+    images.push_back(make_texture(m, s.u_len, s.v_len, density, mix_seed(cfg.seed, stream)));
     w.surfaces_.push_back(s);
-    textures->surfaces.emplace_back(tex, density);
-    return w.surfaces_.size() - 1;
   };
   const cv::Vec3f wall_tints[4] = {{0.85f, 0.95f, 1.1f}, {1.1f, 0.95f, 0.85f},
                                    {0.9f, 1.1f, 0.9f}, {1.05f, 1.0f, 1.05f}};
-  cv::Mat floor_tex;
   for (int axis = 0; axis < 3; ++axis)
     for (int side = 0; side < 2; ++side) {
       Surface s = make_face(w.bounds_, axis, side, true);
       Material m = Material::Wall;
       if (axis < 2) {
         s.tint = wall_tints[2 * axis + side];
-        s.shade = axis == 0 ? 0.9f : 0.8f;
       } else if (side == 0) {
         m = Material::Floor;
         s.tint = {0.95f, 1.0f, 1.0f};
       } else {
         m = Material::Ceiling;
-        s.shade = 0.7f;
       }
       add(s, m, 100 + 2 * axis + side);
     }
-  {
-    // Paint the helipad onto the floor (surface 4) and rebuild its mip pyramid.
-    cv::Mat floor = textures->surfaces[4].level(0).clone();
-    paint_helipad(floor, w.surfaces_[4], w.helipad_, density);
-    textures->surfaces[4] = MipTexture(floor, density);
-  }
   for (size_t i = 0; i < w.obstacles_.size(); ++i) {
     const auto& o = w.obstacles_[i];
     const cv::Vec3f tint = o.kind == Obstacle::Kind::Pillar ? cv::Vec3f(1.0f, 1.0f, 1.0f)
@@ -253,10 +277,30 @@ World World::room(const WorldConfig& cfg) {
       for (int side = 0; side < 2; ++side) {
         Surface s = make_face(o.box, axis, side, false);
         s.tint = tint;
-        s.shade = axis == 2 ? 1.0f : (axis == 0 ? 0.85f : 0.7f);
         add(s, o.kind == Obstacle::Kind::Pillar ? Material::Pillar : Material::Crate,
             1000 + 6 * i + 2 * axis + side);
       }
+  }
+  paint_helipad(images[4], w.surfaces_[4], w.helipad_, density);  // surface 4: the floor
+  // Ceiling lamps on a ~3 m grid (none inside a pillar); the ceiling itself is lit only by
+  // the ambient term, its light panels are in its texture.
+  std::vector<Eigen::Vector3d> lamps;
+  const int nx = std::max(1, static_cast<int>(std::lround(cfg.room_x / 3.0)));
+  const int ny = std::max(1, static_cast<int>(std::lround(cfg.room_y / 3.0)));
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Eigen::Vector3d lamp(w.bounds_.min.x() + cfg.room_x * (i + 0.5) / nx,
+                                 w.bounds_.min.y() + cfg.room_y * (j + 0.5) / ny, cfg.room_z - 0.1);
+      if (!w.occupied(lamp)) lamps.push_back(lamp);
+    }
+  auto textures = std::make_shared<Textures>();
+  for (size_t k = 0; k < images.size(); ++k) {
+    if (k == 5) {
+      w.surfaces_[k].shade = 0.7f;
+    } else {
+      bake_lighting(w, w.surfaces_[k], lamps, images[k]);
+    }
+    textures->surfaces.emplace_back(images[k], density);
   }
   w.textures_ = std::move(textures);
   return w;

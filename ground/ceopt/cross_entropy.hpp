@@ -29,8 +29,8 @@ struct CeOptions {
   int samples = 50;           // N, candidates per iteration
   int elite = 5;              // N_elite
   int max_iterations = 100;
-  double alpha = 0.7;         // mean smoothing, thesis range [0.4, 0.9]
-  double beta = 0.8;          // sigma smoothing, thesis range [0.6, 0.9]
+  double alpha = 0.5;         // mean smoothing, thesis range [0.4, 0.9]
+  double beta = 0.7;          // sigma smoothing, thesis range [0.6, 0.9]
   double q = 5.0;             // thesis range [2, 7]
   double sigma_stop = 0.0;    // stop when every sigma(t) < sigma_stop * sigma(0); 0 = never
   uint64_t seed = 1;

@@ -95,11 +95,15 @@ double FlcTuningProblem::cost(const std::vector<double>& x) const {
   } catch (const std::invalid_argument&) {
     return std::numeric_limits<double>::infinity();
   }
+  return controller_cost(*flc, opt_);
+}
+
+double controller_cost(const flc::Flc& flc, const TrainingOptions& opt) {
   double sum = 0.0;
   int k = 0;
-  for (double speed : opt_.speeds)
-    for (int r = 0; r < opt_.runs_per_speed; ++r, ++k)
-      sum += run_cost(fly(*flc, opt_.scenario, speed, opt_.seed + static_cast<uint64_t>(k), opt_.limits), opt_);
+  for (double speed : opt.speeds)
+    for (int r = 0; r < opt.runs_per_speed; ++r, ++k)
+      sum += run_cost(fly(flc, opt.scenario, speed, opt.seed + static_cast<uint64_t>(k), opt.limits), opt);
   return sum / k;
 }
 

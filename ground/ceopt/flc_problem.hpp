@@ -27,6 +27,9 @@ struct TrainingOptions {
 // Cost of one run: ITSE plus its penalties.
 double run_cost(const sim::AvoidanceResult& r, const TrainingOptions& opt);
 
+// Mean run cost of a controller over the training runs.
+double controller_cost(const flc::Flc& flc, const TrainingOptions& opt);
+
 // One avoidance run of a controller.
 sim::AvoidanceResult fly(const flc::Flc& flc, const sim::AvoidanceConfig& scenario, double speed, uint64_t seed,
                          const flc::CommandLimits& limits, bool record = false);

@@ -136,9 +136,10 @@ int main(int argc, char** argv) {
     in.load_after = read_loadavg();
     in.tuning = &tuning;
     const bool complete = !tuning.stage2.ce.history.empty() && tuning.stage2.ce.stop_reason != "cancelled";
-    spdlog::info("stage 1: {:.1f} s, best cost {:.1f} (iteration {}); stage 2: {:.1f} s, best cost {:.1f} (iteration {})",
-                 tuning.stage1.seconds, tuning.stage1.ce.best_cost, tuning.stage1.ce.best_iteration, tuning.stage2.seconds,
-                 tuning.stage2.ce.best_cost, tuning.stage2.ce.best_iteration);
+    spdlog::info("stage 1: {:.1f} s ({:.1f} s CPU), best cost {:.1f} (iteration {}); stage 2: {:.1f} s ({:.1f} s CPU), best cost {:.1f} "
+                 "(iteration {})",
+                 tuning.stage1.seconds, tuning.stage1.cpu_seconds, tuning.stage1.ce.best_cost, tuning.stage1.ce.best_iteration,
+                 tuning.stage2.seconds, tuning.stage2.cpu_seconds, tuning.stage2.ce.best_cost, tuning.stage2.ce.best_iteration);
     in.controllers.emplace_back("initial", tuning.initial);
     if (!tuning.stage1.ce.best.empty()) in.controllers.emplace_back("sf", tuning.stage1.controller);
     if (!tuning.stage2.ce.best.empty()) in.controllers.emplace_back("sfmf", tuning.stage2.controller);

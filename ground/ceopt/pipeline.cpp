@@ -1,5 +1,7 @@
 #include "ground/ceopt/pipeline.hpp"
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -11,6 +13,12 @@
 
 namespace aerie::ceopt {
 namespace {
+
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 std::vector<CeParameter> parameters_from(const util::Config& cfg, const std::string& key, std::vector<CeParameter> fallback) {
   if (!cfg.has(key)) return fallback;
@@ -39,11 +47,12 @@ std::vector<CeParameter> parameters_from(const util::Config& cfg, const std::str
 CeoptConfig default_ceopt_config() {
   CeoptConfig c;
   // Stage 1 from the hand-tuned factors (all 1, thesis 5.1.3).
-  c.stage1 = {{"Kp", 1.0, 2.0, 0.05, 10.0}, {"Kd", 1.0, 0.5, 0.001, 2.0}, {"Ki", 1.0, 1.0, -3.0, 3.0}};
+  // Initial sigmas of about half the box, so that the first iterations sample all of it.
+  c.stage1 = {{"Kp", 1.0, 5.0, 0.05, 10.0}, {"Kd", 1.0, 1.0, 0.001, 2.0}, {"Ki", 1.0, 3.0, -3.0, 3.0}};
   // Stage 2 from the initial (evenly spaced) positions of the sets the thesis optimises.
-  c.stage2 = {{"error.Left", -45.0, 20.0, -90.0, 0.0},        {"derivative.Negative", -10.0, 5.0, -20.0, 0.0},
-              {"integral.Negative", -5.0, 2.5, -10.0, 0.0},    {"yaw_rate.BigLeft", -67.5, 10.0, -90.0, 0.0},
-              {"yaw_rate.Left", -45.0, 10.0, -90.0, 0.0},      {"yaw_rate.LittleLeft", -22.5, 10.0, -90.0, 0.0}};
+  c.stage2 = {{"error.Left", -45.0, 45.0, -90.0, 0.0},        {"derivative.Negative", -10.0, 10.0, -20.0, 0.0},
+              {"integral.Negative", -5.0, 5.0, -10.0, 0.0},    {"yaw_rate.BigLeft", -67.5, 45.0, -90.0, 0.0},
+              {"yaw_rate.Left", -45.0, 45.0, -90.0, 0.0},      {"yaw_rate.LittleLeft", -22.5, 45.0, -90.0, 0.0}};
   return c;
 }
 
@@ -88,8 +97,9 @@ CeoptConfig ceopt_config_from(const util::Config& cfg) {
   c.stage1 = parameters_from(cfg, "stage1", c.stage1);
   c.stage2 = parameters_from(cfg, "stage2", c.stage2);
   const auto pr = cfg.section("prune");
-  sim::require_known_keys(pr, {"overlap_fraction"});
+  sim::require_known_keys(pr, {"overlap_fraction", "max_cost_increase"});
   c.prune.overlap_fraction = pr.get("overlap_fraction", c.prune.overlap_fraction);
+  c.prune_max_cost_increase = pr.get("max_cost_increase", c.prune_max_cost_increase);
 
   const auto ev = cfg.section("evaluation");
   sim::require_known_keys(ev, {"speeds", "runs_per_speed", "seed"});
@@ -110,11 +120,13 @@ StageResult run_stage(int stage, const flc::FlcSpec& base, const std::vector<CeP
   CeOptions opt = cfg.ce;
   opt.seed = cfg.ce.seed + static_cast<uint64_t>(stage - 1);
   const util::Stopwatch watch;
+  const double cpu0 = process_cpu_seconds();
   r.ce = cross_entropy(
       parameters, opt, [&](const std::vector<double>& x) { return problem.cost(x); }, pool,
       [&](std::vector<double>& x) { problem.repair(x); },
       [&](const CeIteration& it) { return cb ? cb(stage, r.names, it) : true; });
   r.seconds = watch.ms() / 1000.0;
+  r.cpu_seconds = process_cpu_seconds() - cpu0;
   r.controller = problem.controller(r.ce.best);
   r.controller.id = stage == 1 ? "ce-sf" : "ce-sfmf";
   return r;
@@ -126,8 +138,40 @@ TuningResult run_tuning(const CeoptConfig& cfg, ThreadPool& pool, const StageCal
   t.stage1 = run_stage(1, t.initial, cfg.stage1, cfg, pool, cb);
   if (t.stage1.ce.stop_reason == "cancelled") return t;
   t.stage2 = run_stage(2, t.stage1.controller, cfg.stage2, cfg, pool, cb);
-  t.pruned = flc::prune(t.stage2.controller, cfg.prune, &t.prune_report);
+  t.pruned = prune_verified(t.stage2.controller, cfg, &t.prune_report, &t.prune_steps);
   return t;
+}
+
+flc::FlcSpec prune_verified(const flc::FlcSpec& spec, const CeoptConfig& cfg, flc::PruneReport* report,
+                            std::vector<PruneStep>* steps) {
+  const double base = controller_cost(flc::Flc(spec), cfg.training);
+  flc::FlcSpec current = spec;
+  flc::PruneReport total;
+  for (const flc::Variable* v : {&spec.inputs[0], &spec.inputs[1], &spec.inputs[2], &spec.output}) {
+    flc::PruneOptions opt = cfg.prune;
+    opt.variables = {v->name};
+    flc::PruneReport r;
+    const flc::FlcSpec candidate = flc::prune(current, opt, &r);
+    if (r.removed_sets.empty()) continue;
+    PruneStep step{v->name, r.removed_sets, controller_cost(flc::Flc(current), cfg.training),
+                   controller_cost(flc::Flc(candidate), cfg.training), false};
+    step.accepted = cfg.prune_max_cost_increase < 0.0 || step.cost_after <= base * (1.0 + cfg.prune_max_cost_increase);
+    if (step.accepted) {
+      current = candidate;
+      total.removed_sets.insert(total.removed_sets.end(), r.removed_sets.begin(), r.removed_sets.end());
+    }
+    if (steps) steps->push_back(step);
+  }
+  auto sets = [](const flc::FlcSpec& s) {
+    return s.inputs[0].size() + s.inputs[1].size() + s.inputs[2].size() + s.output.size();
+  };
+  total.rules_before = static_cast<int>(spec.rules.size());
+  total.rules_after = static_cast<int>(current.rules.size());
+  total.sets_before = sets(spec);
+  total.sets_after = sets(current);
+  current.id = spec.id + "-pruned";
+  if (report) *report = total;
+  return current;
 }
 
 std::vector<ExperimentRun> run_experiment(const std::vector<std::pair<std::string, flc::FlcSpec>>& controllers,

@@ -29,6 +29,10 @@ struct CeoptConfig {
   TrainingOptions training;
   std::vector<CeParameter> stage1, stage2;
   flc::PruneOptions prune;
+  // A merge of overlapping sets is kept only if the training cost stays within
+  // (1 + this) of the unpruned controller's; < 0 keeps every overlap merge (the
+  // thesis' plain reduction).
+  double prune_max_cost_increase = 0.1;
   EvaluationOptions evaluation;
 };
 
@@ -42,14 +46,29 @@ struct StageResult {
   CeResult ce;
   flc::FlcSpec controller;            // the base with the winner's parameters
   double seconds = 0.0;               // wall-clock time of the stage
+  double cpu_seconds = 0.0;           // CPU time of the process over the stage (all threads)
+};
+
+// One variable's merge of overlapping sets, tried on the training runs.
+struct PruneStep {
+  std::string variable;
+  std::vector<std::string> merges;   // "<variable>.<set> -> <kept set>"
+  double cost_before = 0.0, cost_after = 0.0;
+  bool accepted = false;
 };
 
 struct TuningResult {
   flc::FlcSpec initial;
   StageResult stage1, stage2;
   flc::FlcSpec pruned;
-  flc::PruneReport prune_report;
+  flc::PruneReport prune_report;     // stage-2 controller -> pruned, over the accepted merges
+  std::vector<PruneStep> prune_steps;
 };
+
+// Overlap pruning (flc::prune) one variable at a time, each merge verified on the
+// training runs against cfg.prune_max_cost_increase.
+flc::FlcSpec prune_verified(const flc::FlcSpec& spec, const CeoptConfig& cfg, flc::PruneReport* report,
+                            std::vector<PruneStep>* steps);
 
 // Called after every CE iteration with the stage; return false to stop (Ctrl-C).
 using StageCallback = std::function<bool(int stage, const std::vector<std::string>& names, const CeIteration&)>;

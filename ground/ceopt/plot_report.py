@@ -5,6 +5,7 @@ Writes cost.png, pdf_stage1.png, pdf_stage2.png (PDF evolution per parameter, li
 thesis' Figs. 5.16-5.25), mfs.png (membership functions, Figs. 5.6-5.9 / 5.26-5.29),
 trajectories.png, heading.png and rmse.png."""
 import csv
+import json
 import math
 import os
 import sys
@@ -71,8 +72,9 @@ def plot_pdfs(out, stage):
         sg = np.array([float(x["sigma_" + name]) for x in r])
         lo = min(mu[0] - 3 * sg[0], (mu - 3 * sg).min())
         hi = max(mu[0] + 3 * sg[0], (mu + 3 * sg).max())
-        xs = np.linspace(lo, hi, 400)
         for k in pick:
+            # Sample each Gaussian around its own mean so that narrow late ones are drawn.
+            xs = np.concatenate(([lo], np.linspace(mu[k] - 4 * sg[k], mu[k] + 4 * sg[k], 200), [hi]))
             pdf = np.exp(-0.5 * ((xs - mu[k]) / sg[k]) ** 2) / (sg[k] * math.sqrt(2 * math.pi))
             ax.plot(xs, np.full_like(xs, its[k]), pdf, color=plt.cm.viridis(k / max(1, len(r) - 1)), lw=1)
         ax.set_xlabel(name)
@@ -81,7 +83,7 @@ def plot_pdfs(out, stage):
         ax.set_title(f"{name}: mean {mu[-1]:.4g}, sigma {sg[-1]:.2g}", fontsize=9)
     fig.suptitle(f"Stage {stage}: evolution of the sampling PDF of each parameter")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, f"pdf_stage{stage}.png"), dpi=100)
+    fig.savefig(os.path.join(out, f"pdf_stage{stage}.png"), dpi=75)
     plt.close(fig)
 
 
@@ -112,7 +114,7 @@ def plot_mfs(out):
             ax.set_title(f"{c}: {v}", fontsize=9)
     fig.suptitle("Membership functions (scaled units; output sets as their peaks)")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "mfs.png"), dpi=100)
+    fig.savefig(os.path.join(out, "mfs.png"), dpi=80)
     plt.close(fig)
 
 
@@ -124,25 +126,35 @@ def trajectories(out):
     return data
 
 
+def scene(out):
+    try:
+        with open(os.path.join(out, "summary.json")) as f:
+            return json.load(f)["scene"]
+    except (OSError, KeyError, ValueError):
+        return {"normal_area_m": 1.0, "safe_area_m": 3.0, "wall_m": 5.0, "lateral_limit_m": 5.0}
+
+
 def plot_trajectories(out, data):
     if not data:
         return
+    sc = scene(out)
+    nfa, saa, wall = sc["normal_area_m"], sc["normal_area_m"] + sc["safe_area_m"], sc["wall_m"]
     speeds = sorted({s for _, s in data})
     fig, axes = plt.subplots(1, len(speeds), figsize=(5 * len(speeds), 5), squeeze=False)
     for k, speed in enumerate(speeds):
         ax = axes[0][k]
-        ax.axhspan(0, 1, color="tab:green", alpha=0.08, label="normal flight area")
-        ax.axhspan(1, 4, color="tab:orange", alpha=0.08, label="safe avoiding area")
-        ax.axhspan(4, 5, color="tab:red", alpha=0.12, label="dangerous alarm area")
-        ax.axhline(5, color="k", lw=3, label="wall")
+        ax.axhspan(0, nfa, color="tab:green", alpha=0.08, label="normal flight area")
+        ax.axhspan(nfa, saa, color="tab:orange", alpha=0.08, label="safe avoiding area")
+        ax.axhspan(saa, wall, color="tab:red", alpha=0.12, label="dangerous alarm area")
+        ax.axhline(wall, color="k", lw=3, label="wall")
         for (c, s), pts in data.items():
             if s != speed:
                 continue
-            ax.plot([float(p["x"]) for p in pts], [float(p["y"]) for p in pts], color=COLORS.get(c), label=c)
-        ax.set_xlim(-1, 6)
-        ax.set_ylim(-0.2, 5.5)
+            ax.plot([abs(float(p["x"])) for p in pts], [float(p["y"]) for p in pts], color=COLORS.get(c), label=c)
+        ax.set_xlim(-0.5, sc["lateral_limit_m"] + 0.5)
+        ax.set_ylim(-0.2, wall + 0.5)
         ax.set_aspect("equal")
-        ax.set_xlabel("x (m)")
+        ax.set_xlabel("sideways |x| (m; left turns mirrored)")
         ax.set_ylabel("y (m), toward the wall")
         ax.set_title(f"{speed} m/s")
         if k == 0:
@@ -164,9 +176,10 @@ def plot_heading(out, data):
                 continue
             t = [float(p["t"]) for p in pts]
             h = [float(p["heading_deg"]) for p in pts]
-            axes[0][k].plot(t, h, color=COLORS.get(c), label=c)
             ref = [float(p["reference_deg"]) if p["active"] == "1" else float("nan") for p in pts]
-            axes[1][k].plot(t, [hh - rr for hh, rr in zip(h, ref)], color=COLORS.get(c), label=c)
+            sign = -1.0 if any(r < 0 for r in ref if not math.isnan(r)) else 1.0  # left turns mirrored
+            axes[0][k].plot(t, [sign * hh for hh in h], color=COLORS.get(c), label=c)
+            axes[1][k].plot(t, [sign * (hh - rr) for hh, rr in zip(h, ref)], color=COLORS.get(c), label=c)
         axes[0][k].axhline(90, color="k", ls=":", lw=1)
         axes[0][k].set_title(f"{speed} m/s")
         axes[0][k].set_ylabel("heading (deg)")
@@ -176,7 +189,7 @@ def plot_heading(out, data):
         axes[1][k].grid(alpha=0.3)
         axes[0][k].grid(alpha=0.3)
     axes[0][0].legend(fontsize=8)
-    fig.suptitle("Heading over time (true heading; the lower row zooms on the steady state)")
+    fig.suptitle("Heading over time (true heading, left turns mirrored; the lower row zooms on the steady state)")
     fig.tight_layout()
     fig.savefig(os.path.join(out, "heading.png"), dpi=100)
     plt.close(fig)
@@ -198,6 +211,7 @@ def plot_rmse(out):
                 for s in speeds]
         errs = [next((float(x["rmse_std_deg"]) for x in r if x["controller"] == c and float(x["speed"]) == s), np.nan)
                 for s in speeds]
+        errs = [0 if np.isnan(e) else e for e in errs]
         ax.bar(np.arange(len(speeds)) + i * w, vals, w, yerr=errs, color=COLORS.get(c), label=f"{c} (simulation)")
     for i, c in enumerate(["sf", "sfmf"]):
         ax.bar(np.arange(len(speeds)) + (len(controllers) + i) * w, [THESIS[c].get(s, np.nan) for s in speeds], w,

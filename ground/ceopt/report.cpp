@@ -33,7 +33,7 @@ std::string g(double v) {
 
 class Writer {
  public:
-  Writer(const fs::path& path, std::vector<std::string>& written) : path_(path), out_(path) {
+  Writer(const fs::path& path, std::vector<std::string>& written) : out_(path) {
     if (!out_) throw std::runtime_error(path.string() + ": cannot write");
     written.push_back(path.string());
   }
@@ -42,10 +42,8 @@ class Writer {
     out_ << v;
     return *this;
   }
-  ~Writer() { out_.flush(); }
 
  private:
-  fs::path path_;
   std::ofstream out_;
 };
 
@@ -140,11 +138,15 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
     w << "{\n  \"command\": \"" << in.command_line << "\",\n  \"threads\": " << in.threads << ",\n  \"loadavg_before\": \""
       << in.load_before << "\",\n  \"loadavg_after\": \"" << in.load_after << "\",\n  \"samples\": " << cfg.ce.samples
       << ",\n  \"elite\": " << cfg.ce.elite << ",\n  \"runs_per_evaluation\": "
-      << cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed) << ",\n  \"stages\": [";
+      << cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed) << ",\n  \"scene\": {\"normal_area_m\": "
+      << g(cfg.training.scenario.scene.normal_area_m) << ", \"safe_area_m\": " << g(cfg.training.scenario.scene.safe_area_m)
+      << ", \"wall_m\": " << g(cfg.training.scenario.scene.wall_y_m) << ", \"lateral_limit_m\": "
+      << g(cfg.training.scenario.scene.lateral_limit_m) << "},\n  \"stages\": [";
     bool first = true;
     for (const StageResult* st : {&t.stage1, &t.stage2}) {
       if (st->ce.history.empty()) continue;
       w << (first ? "" : ",") << "\n    {\"stage\": " << st->stage << ", \"seconds\": " << g(st->seconds)
+        << ", \"cpu_seconds\": " << g(st->cpu_seconds)
         << ", \"iterations\": " << st->ce.history.size() << ", \"evaluations\": " << st->ce.evaluations
         << ", \"best_cost\": " << g(st->ce.best_cost) << ", \"winner_iteration\": " << st->ce.best_iteration
         << ", \"stop_reason\": \"" << st->ce.stop_reason << "\", \"best\": {";
@@ -154,7 +156,7 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
     }
     w << "\n  ],\n  \"prune\": {\"rules_before\": " << t.prune_report.rules_before << ", \"rules_after\": " << t.prune_report.rules_after
       << ", \"sets_before\": " << t.prune_report.sets_before << ", \"sets_after\": " << t.prune_report.sets_after
-      << ", \"removed\": [";
+      << ", \"max_cost_increase\": " << g(cfg.prune_max_cost_increase) << ", \"removed\": [";
     for (size_t k = 0; k < t.prune_report.removed_sets.size(); ++k)
       w << (k ? ", " : "") << "\"" << t.prune_report.removed_sets[k] << "\"";
     w << "]},\n  \"experiment\": [";
@@ -177,12 +179,12 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
       << ", beta = " << cfg.ce.beta << ", q = " << cfg.ce.q << "; each candidate flies "
       << cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed)
       << " training runs (cost: mean ITSE + penalties).\n\n"
-      << "| stage | parameters | iterations | evaluations | time (s) | best cost | winner iteration | best values |\n"
-      << "|---|---|---|---|---|---|---|---|\n";
+      << "| stage | parameters | iterations | evaluations | wall time (s) | CPU time (s) | best cost | winner iteration | best values |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
     for (const StageResult* st : {&t.stage1, &t.stage2}) {
       if (st->ce.history.empty()) continue;
       w << "| " << st->stage << " | " << st->names.size() << " | " << st->ce.history.size() << " | " << st->ce.evaluations << " | "
-        << f(st->seconds, 1) << " | " << f(st->ce.best_cost, 1) << " | " << st->ce.best_iteration << " | ";
+        << f(st->seconds, 1) << " | " << f(st->cpu_seconds, 1) << " | " << f(st->ce.best_cost, 1) << " | " << st->ce.best_iteration << " | ";
       for (size_t j = 0; j < st->names.size(); ++j) w << (j ? ", " : "") << st->names[j] << " = " << f(st->ce.best[j], 4);
       w << " |\n";
     }
@@ -190,6 +192,16 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
       << t.prune_report.rules_after << ", sets " << t.prune_report.sets_before << " -> " << t.prune_report.sets_after << "; removed: ";
     for (size_t k = 0; k < t.prune_report.removed_sets.size(); ++k) w << (k ? ", " : "") << "`" << t.prune_report.removed_sets[k] << "`";
     w << (t.prune_report.removed_sets.empty() ? "none" : "") << ".\n\n";
+    if (!t.prune_steps.empty()) {
+      w << "| merge tried | training cost before | after | kept (limit +" << f(100 * cfg.prune_max_cost_increase, 0)
+        << " % of the unpruned cost) |\n|---|---|---|---|\n";
+      for (const auto& st : t.prune_steps) {
+        w << "| ";
+        for (size_t k = 0; k < st.merges.size(); ++k) w << (k ? ", " : "") << "`" << st.merges[k] << "`";
+        w << " | " << f(st.cost_before, 1) << " | " << f(st.cost_after, 1) << " | " << (st.accepted ? "yes" : "no") << " |\n";
+      }
+      w << "\n";
+    }
     w << "## Avoidance experiment (" << cfg.evaluation.runs_per_speed << " runs per case, sensor noise "
       << cfg.training.scenario.sensor.noise_std_deg << " deg, latency " << cfg.training.scenario.sensor.delay_s
       << " s, safe avoiding area " << cfg.training.scenario.scene.safe_area_m << " m)\n\n"
@@ -202,7 +214,8 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
           if (s.controller == "sf") thesis = f(th.sf, 2);
           if (s.controller == "sfmf") thesis = f(th.sfmf, 2);
         }
-      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << f(s.rmse_mean, 2) << " ± " << f(s.rmse_std, 2) << " | "
+      const std::string rmse = s.settled ? f(s.rmse_mean, 2) + " ± " + f(s.rmse_std, 2) : "never settled";
+      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << rmse << " | "
         << thesis << " | " << f(s.min_wall_distance, 2) << " | " << s.entered_dangerous << "/" << s.runs << " | " << s.collided
         << " | " << s.settled << "/" << s.runs << " |\n";
     }

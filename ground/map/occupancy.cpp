@@ -113,6 +113,7 @@ struct OccupancyMap::FrameBuffer {
   struct Ray {
     uint64_t end;
     bool hit;
+    Eigen::Vector3d point;  // the measured point (or the max-range point), not the voxel centre
   };
   std::vector<Ray> candidates;  // one per usable point
   VoxelMarks ends;              // end voxels that already have a ray
@@ -221,7 +222,7 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
       ++stats.out_of_bounds;
       continue;
     }
-    f.candidates.push_back({pack_key(key), hit});
+    f.candidates.push_back({pack_key(key), hit, p});
   }
   // One ray per end voxel, hits first: a voxel that ends both a hit and a truncated ray is a hit.
   for (const bool hits : {true, false})
@@ -238,22 +239,25 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
     const double r = (Eigen::Vector3d(tree.keyToCoord(key[0]), tree.keyToCoord(key[1]), tree.keyToCoord(key[2])) -
                       origin).norm();
     const double sigma = stereo.range_sigma(r);
-    const float weight = sigma > 0 ? static_cast<float>(std::erf(res / (2.0 * std::sqrt(2.0) * sigma))) : 1.f;
+    const float weight = sigma > 0 && stereo.weight_hits
+                             ? static_cast<float>(std::erf(res / (2.0 * std::sqrt(2.0) * sigma)))
+                             : 1.f;
     f.voxels.mark(key);
     f.updates.push_back({ray.end, std::max(weight, 1e-3f)});
   }
   stats.hit_voxels = f.updates.size();
 
   // 3. Free space along each ray, in key space, up to the margin before a hit; a voxel is
-  // free only if the ray leaves it before that point. Voxels already in the frame keep
-  // their first update: each voxel is updated once per frame.
+  // free only if the ray leaves it before that point. Rays go to the measured point, not
+  // to the voxel centre (which, at grazing incidence, would cut into the surface). Voxels
+  // already in the frame keep their first update: each voxel is updated once per frame.
   for (const auto& ray : f.rays) {
     const octomap::OcTreeKey end_key = unpack_key(ray.end);
-    const Eigen::Vector3d end(tree.keyToCoord(end_key[0]), tree.keyToCoord(end_key[1]), tree.keyToCoord(end_key[2]));
+    const Eigen::Vector3d& end = ray.point;
     const double length = (end - origin).norm();
     if (length <= 0) continue;
     const double free_length =
-        ray.hit ? length - stereo.free_margin_sigmas * stereo.range_sigma(length) : length + res;
+        ray.hit ? length - stereo.free_margin_sigmas * stereo.range_sigma(length) : length;
     if (free_length <= 0) continue;
     const Eigen::Vector3d direction = (end - origin) / length;
     traverse_keys(origin, direction, free_length, res, 0, [&](const octomap::OcTreeKey& k, double, double t_exit) {

@@ -50,6 +50,14 @@ class ProcmanLcm : public ::testing::Test {
     return std::make_unique<testbed::Process>(
         in(*ns_, {bin("aerie-deputy"), "--name", name, "--lcm-url", kUrl}), (dir_ / log).string());
   }
+  // aerie-sheriff CONFIG --script SCRIPT --on-script-complete exit, in the namespace.
+  std::unique_ptr<testbed::Process> sheriff(const std::string& config, const std::string& script,
+                                            std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{bin("aerie-sheriff"), config, "--script", script, "--on-script-complete", "exit",
+                                  "--wait-timeout", "30", "--no-table", "--lcm-url", kUrl};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return std::make_unique<testbed::Process>(in(*ns_, argv), (dir_ / ("sheriff-" + script + ".log")).string());
+  }
   std::string write_config(const std::string& text) {
     const auto p = dir_ / "test.pmd";
     std::ofstream(p) << text;
@@ -76,11 +84,9 @@ TEST_F(ProcmanLcm, SheriffScriptStartsAndStopsCommandsOnADeputy) {
       "  stop cmd \"talker\" wait \"stopped\";\n"
       "}\n");
   auto dep = deputy("h1", "deputy.log");
-  testbed::Process sheriff(in(*ns_, {bin("aerie-sheriff"), cfg, "--script", "start_all", "--on-script-complete", "exit",
-                                     "--wait-timeout", "30", "--show-output", "--no-table", "--lcm-url", kUrl}),
-                           (dir_ / "sheriff.log").string());
-  const auto rc = sheriff.wait(60s);
-  const std::string log = sheriff.log();
+  auto sh = sheriff(cfg, "start_all", {"--show-output"});
+  const auto rc = sh->wait(60s);
+  const std::string log = sh->log();
   ASSERT_TRUE(rc.has_value()) << log;
   EXPECT_EQ(*rc, 0) << log;
   EXPECT_TRUE(contains(log, "script: done")) << log;
@@ -104,11 +110,10 @@ TEST_F(ProcmanLcm, ObserverWatchesAndDeputyExitLeavesNothingRunning) {
       "stop_signal = 15; stop_time_allowed = 1; }\n"
       "script \"start\" { start everything wait \"running\"; }\n");
   auto dep = deputy("h1", "deputy.log");
-  testbed::Process sheriff(in(*ns_, {bin("aerie-sheriff"), cfg, "--script", "start", "--on-script-complete", "exit",
-                                     "--wait-timeout", "30", "--no-table", "--lcm-url", kUrl}),
-                           (dir_ / "sheriff.log").string());
-  ASSERT_EQ(sheriff.wait(60s).value_or(-1), 0) << sheriff.log();
+  auto sh = sheriff(cfg, "start");
+  ASSERT_EQ(sh->wait(60s).value_or(-1), 0) << sh->log();
   // The sheriff is gone; the command keeps running. An observer sees it.
+  for (int i = 0; i < 500 && (read_pid(pidfile) == 0 || read_pid(childfile) == 0); ++i) std::this_thread::sleep_for(10ms);
   const pid_t leader = read_pid(pidfile);
   ASSERT_TRUE(alive(leader));
   ASSERT_TRUE(alive(read_pid(childfile)));
@@ -125,6 +130,27 @@ TEST_F(ProcmanLcm, ObserverWatchesAndDeputyExitLeavesNothingRunning) {
   EXPECT_FALSE(alive(leader));
   const pid_t child = read_pid(childfile);
   EXPECT_GT(child, 0);
+  EXPECT_FALSE(alive(child));
+}
+
+TEST_F(ProcmanLcm, CommandsDieWithAKilledDeputy) {
+  // Even SIGKILL (no clean-up possible): the command dies with its deputy
+  // (PR_SET_PDEATHSIG) and its children with their terminal's session (SIGHUP).
+  const std::string pidfile = (dir_ / "leader.pid").string(), childfile = (dir_ / "child.pid").string();
+  const std::string cfg = write_config("cmd \"c\" { exec = \"sh -c 'echo $$ > " + pidfile + "; sleep 1000 & echo $! > " +
+                                       childfile + "; wait'\"; host = \"h1\"; }\n"
+                                       "script \"start\" { start everything wait \"running\"; }\n");
+  auto dep = deputy("h1", "deputy.log");
+  auto sh = sheriff(cfg, "start");
+  ASSERT_EQ(sh->wait(60s).value_or(-1), 0) << sh->log();
+  for (int i = 0; i < 500 && (read_pid(pidfile) == 0 || read_pid(childfile) == 0); ++i) std::this_thread::sleep_for(10ms);
+  const pid_t leader = read_pid(pidfile), child = read_pid(childfile);
+  ASSERT_TRUE(alive(leader));
+  ASSERT_TRUE(alive(child));
+  dep->stop(SIGKILL, 5s);
+  const auto until = std::chrono::steady_clock::now() + 5s;
+  while ((alive(leader) || alive(child)) && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(20ms);
+  EXPECT_FALSE(alive(leader));
   EXPECT_FALSE(alive(child));
 }
 

@@ -59,7 +59,7 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
 
   AvoidanceResult res;
   double applied = 0.0, last_command = 0.0, measured = 0.0;
-  double sq_sum = 0.0, sq_time = 0.0;
+  double sq_sum = 0.0, sq_time = 0.0, sq_settle = 0.0, t_settle = 0.0;  // error^2 integrals over the active phase
   const long max_steps = std::lround(cfg.max_time_s / dt);
   for (long k = 0;; ++k) {
     const double t = k * dt;
@@ -75,10 +75,14 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
       const double ta = t - res.activation_time_s;
       res.itse += ta * e * e * dt;
       res.iae += std::abs(e) * dt;
-      if (res.settle_time_s < 0.0 && std::abs(e) <= cfg.settle_band_deg) res.settle_time_s = ta;
-      if (res.settle_time_s >= 0.0) {
-        sq_sum += e * e * dt;
-        sq_time += dt;
+      // Settling: the last time the error is outside the band (the usual settling
+      // time); the steady state is what follows it.
+      sq_sum += e * e * dt;
+      sq_time += dt;
+      if (std::abs(e) > cfg.settle_band_deg) {
+        res.settle_time_s = ta + dt;
+        sq_settle = sq_sum;
+        t_settle = sq_time;
       }
     }
     // End of the run.
@@ -117,7 +121,10 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
     vehicle.step(applied, cfg.speed_m_s, gust);
   }
   res.min_wall_distance_m = cfg.scene.wall_y_m - res.max_y_m;
-  if (sq_time > 0.0) res.steady_rmse_deg = std::sqrt(sq_sum / sq_time);
+  if (sq_time - t_settle > 1e-9 && res.settle_time_s >= 0.0)
+    res.steady_rmse_deg = std::sqrt((sq_sum - sq_settle) / (sq_time - t_settle));
+  else
+    res.settle_time_s = -1.0;  // never within the band, or only at the very end
   return res;
 }
 

@@ -62,7 +62,7 @@ struct AvoidanceConfig {
   // standard deviation grows with the airspeed.
   double yaw_gust_std_per_speed = 3.0;   // (deg/s) per (m/s)
   double yaw_gust_time_constant_s = 0.5;
-  double settle_band_deg = 9.0;          // steady state begins when |error| first <= this
+  double settle_band_deg = 4.5;          // steady state: after the error has entered this band for good (5 % of 90 deg)
   bool record = false;                   // keep the trajectory
 };
 
@@ -87,7 +87,7 @@ struct AvoidanceResult {
   double reference_deg = 0.0;
   double itse = 0.0;           // integral of (t - t_activation) * error^2 dt, deg^2 s^2 (true heading)
   double iae = 0.0;            // integral of |error| dt
-  double settle_time_s = -1.0; // from activation to the first |error| <= band; -1 if never
+  double settle_time_s = -1.0; // from activation to the last time |error| > band; -1 if it never settled
   double steady_rmse_deg = -1.0;  // RMSE of the true heading from settling to the end; -1 if never settled
   double max_y_m = 0.0;
   double min_wall_distance_m = 0.0;

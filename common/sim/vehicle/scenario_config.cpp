@@ -8,7 +8,7 @@ namespace aerie::sim {
 
 void require_known_keys(const util::Config& section, std::initializer_list<const char*> allowed) {
   const YAML::Node& n = section.node();
-  if (!n) return;
+  if (!n || n.IsNull()) return;
   if (!n.IsMap()) throw std::runtime_error(section.origin() + ": expected a map");
   for (const auto& kv : n) {
     const auto key = kv.first.as<std::string>();
@@ -23,7 +23,11 @@ void require_known_keys(const util::Config& section, std::initializer_list<const
 AvoidanceConfig avoidance_config_from(const util::Config& s, AvoidanceConfig c) {
   require_known_keys(s, {"vehicle", "vehicle_params", "scene", "sensor", "camera", "gusts", "physics_substeps", "max_time_s",
                          "settle_band_deg"});
-  c.vehicle = VehicleParams::by_name(s.get<std::string>("vehicle", c.vehicle.name));
+  try {
+    c.vehicle = VehicleParams::by_name(s.get<std::string>("vehicle", c.vehicle.name));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(s.origin() + ": 'vehicle': " + e.what());
+  }
   const auto vp = s.section("vehicle_params");
   require_known_keys(vp, {"yaw_time_constant_s", "max_yaw_rate_deg_s", "velocity_time_constant_s", "command_delay_s"});
   c.vehicle.yaw_time_constant_s = vp.get("yaw_time_constant_s", c.vehicle.yaw_time_constant_s);

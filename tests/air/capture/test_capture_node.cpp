@@ -196,3 +196,34 @@ TEST(CaptureNode, UnreadableFramesAreCountedAndSkipped) {
 
 }  // namespace
 }  // namespace aerie::capture
+
+namespace aerie::capture {
+namespace {
+
+// Looping a recorded source: times keep increasing by the frame interval across the
+// restart, seq goes on, and the duration limit ends the run.
+TEST(CaptureNode, LoopKeepsTimesAndSeqIncreasing) {
+  const auto dir = test::scratch_dir("folder");
+  for (int i = 0; i < 3; ++i)
+    cv::imwrite((dir / (std::to_string(i) + ".png")).string(), cv::Mat(16, 16, CV_8UC1, cv::Scalar(i * 10)));
+  bus::Bus bus("memq://");
+  std::vector<aerie::image_t> mono;
+  bus.subscribe<aerie::image_t>("CAM_MONO", [&](const auto& m, const auto&) { mono.push_back(m); }, 100);
+  CaptureConfig cfg;
+  cfg.rate = 0;
+  cfg.loop = true;
+  cfg.duration_s = 0.4;
+  CaptureNode node(bus, cfg, std::make_unique<ImageFolderSource>(dir.string(), "", 20, false));
+  EXPECT_EQ(node.run().published, 8);
+  while (bus.handle(0) > 0) {
+  }
+  ASSERT_EQ(mono.size(), 8u);
+  for (size_t i = 0; i < mono.size(); ++i) {
+    EXPECT_EQ(mono[i].utime, static_cast<int64_t>(i) * 50'000);
+    EXPECT_EQ(image::sequence_number(mono[i]), static_cast<int64_t>(i));
+    EXPECT_EQ(image::from_message(mono[i]).at<uint8_t>(0, 0), (i % 3) * 10);
+  }
+}
+
+}  // namespace
+}  // namespace aerie::capture

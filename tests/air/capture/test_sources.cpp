@@ -13,6 +13,7 @@
 #include "air/capture/image_folder_source.hpp"
 #include "air/capture/output_format.hpp"
 #include "air/capture/pacer.hpp"
+#include "air/capture/sim_source.hpp"
 #include "air/capture/source_factory.hpp"
 #include "air/capture/stereo_sequence_source.hpp"
 #include "air/capture/video_source.hpp"
@@ -327,6 +328,56 @@ SourceOptions source(const std::string& type, const std::string& path = "") {
   o.type = type;
   o.path = path;
   return o;
+}
+
+// The simulator source: frames at the rig size, times from start_utime, ground truth
+// equal to the simulator's own, and the helipad box in the image when it is visible.
+TEST(SimSource, FramesTimesAndGroundTruth) {
+  SimSourceOptions o;
+  o.start_utime = 5'000'000;
+  SimSource src(o, 188, 120, false, 10.0);
+  EXPECT_TRUE(src.stereo());
+  EXPECT_EQ(src.size(), cv::Size(188, 120));
+  const auto r = src.rectified();
+  ASSERT_TRUE(r);
+  EXPECT_DOUBLE_EQ(r->baseline, 0.12);
+  EXPECT_NEAR(r->fx, 94.0 / std::tan(49.0 * CV_PI / 180), 1e-9);  // 98 deg horizontal field of view
+  EXPECT_GT(src.frame_count(), 400);  // about a minute at 10 Hz
+
+  const auto world = sim::World::room(sim::WorldConfig{});
+  sim::RigConfig rig;
+  rig.width = 188;
+  rig.height = 120;
+  const sim::StereoSimulation reference(world, rig, sim::Trajectory::demo_flight(world, 0.8), 10.0, 5'000'000);
+  EXPECT_EQ(src.frame_count(), reference.frame_count());
+  // A frame with the helipad in view (found from the ground truth alone, without rendering).
+  int k = -1;
+  for (int i = 0; i < reference.frame_count() && k < 0; i += 5) {
+    sim::StereoFrame probe;
+    reference.renderer().project_helipad(reference.trajectory().pose(reference.time_of(i)) * reference.T_body_left(), probe);
+    if (probe.target_visible) k = i;
+  }
+  ASSERT_GE(k, 0) << "the helipad is never in view";
+  src.seek(k);
+  Frame f;
+  ASSERT_TRUE(src.next(f));
+  const auto expect = reference.frame(k);
+  EXPECT_EQ(f.index, k);
+  EXPECT_EQ(f.utime, 5'000'000 + k * 100'000);
+  EXPECT_EQ(cv::norm(f.left, expect.left, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(f.right, expect.right, cv::NORM_INF), 0);
+  ASSERT_TRUE(f.gt_pose);
+  EXPECT_EQ(f.gt_pose->frame_id, "sim");
+  EXPECT_LT((f.gt_pose->T_world_camera.translation() - expect.T_world_left.translation()).norm(), 1e-12);
+  ASSERT_TRUE(f.gt_box);
+  EXPECT_TRUE(expect.target_visible);
+  EXPECT_TRUE(f.gt_box->visible);
+  EXPECT_EQ(f.gt_box->box, expect.target_box);
+  EXPECT_EQ(f.gt_box->target, "helipad");
+
+  SimSourceOptions bad;
+  bad.trajectory = "loop-the-loop";
+  EXPECT_ERROR_NAMES(SimSource(bad, 0, 0, false, 20), "loop-the-loop");
 }
 
 TEST(SourceFactory, BadOptionsAreExplained) {

@@ -361,6 +361,13 @@ TEST(Prune, ThesisOptimisedControllerReducesTo45Rules) {
       for (int e = 0; e < 3; ++e)
         EXPECT_EQ(consequent(p, p.inputs[0].sets[e], p.inputs[1].sets[d], integral), rows[d][e])
             << integral << " / " << p.inputs[1].sets[d] << " / " << p.inputs[0].sets[e];
+  // Restricted to one variable: only the error's sets merge (5 x 5 x 5 -> 3 x 5 x 5 rules).
+  PruneOptions only_error;
+  only_error.variables = {"error"};
+  const FlcSpec e = prune(thesis_optimised(), only_error);
+  EXPECT_EQ(e.rules.size(), 75u);
+  EXPECT_EQ(e.output.size(), 9);
+  EXPECT_EQ(e.inputs[2].size(), 5);
   // Nothing overlaps in the initial controller.
   EXPECT_EQ(prune(thesis_initial()).rules.size(), 125u);
 }

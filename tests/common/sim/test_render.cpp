@@ -2,6 +2,7 @@
 // and with the images; determinism; texture quality for feature tracking.
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -180,6 +181,32 @@ TEST(SimRender, RightImageMatchesLeftThroughDisparity) {
   EXPECT_GT(nccs[nccs.size() / 10], 0.85);  // 90 % of the patches
 }
 
+TEST(SimRender, StereoMatchingRecoversTheDisparity) {
+  // The textures must let a standard matcher (OpenCV SGBM) find the true disparity.
+  const World& w = test::default_world();
+  RigConfig rig;
+  rig.disparity = true;
+  rig.noise_sigma = 1.0;
+  StereoSimulation sim(w, rig, Trajectory::demo_flight(w));
+  auto sgbm = cv::StereoSGBM::create(0, 64, 5, 8 * 25, 32 * 25, 1, 0, 10, 100, 2, cv::StereoSGBM::MODE_SGBM);
+  for (int k : {200, 450, 700}) {
+    const StereoFrame f = sim.frame(k);
+    cv::Mat disp16;
+    sgbm->compute(f.left, f.right, disp16);
+    int valid = 0, good = 0;
+    for (int v = 0; v < disp16.rows; ++v)
+      for (int u = 64; u < disp16.cols; ++u) {  // columns with the full search range
+        const short d = disp16.at<short>(v, u);
+        if (d < 0) continue;
+        ++valid;
+        good += std::abs(d / 16.0 - f.disparity.at<float>(v, u)) <= 1.0;
+      }
+    const double area = (disp16.cols - 64.0) * disp16.rows;
+    EXPECT_GT(valid, 0.9 * area) << "frame " << k;
+    EXPECT_GT(good, 0.95 * valid) << "frame " << k;
+  }
+}
+
 TEST(SimRender, HelipadBoxIsTheProjectionOfItsCorners) {
   const World& w = test::light_world();
   StereoSimulation sim = landing_simulation(w, landing_rig());
@@ -264,10 +291,33 @@ TEST(SimRender, PhotometricOptions) {
   EXPECT_EQ(col.left.type(), CV_8UC3);
   EXPECT_EQ(col.right.type(), CV_8UC3);
   rig.color = false;
+  rig.exposure = 0.5;  // no saturation below
   rig.illumination_amplitude = 0.3;
   rig.illumination_period = 4.0;
   const StereoFrame bright = StereoRenderer(w, rig).render(pose, 1'000'000, 0);  // sin = 1
-  EXPECT_NEAR(cv::mean(bright.left)[0], 1.3 * cv::mean(base.left)[0], 2.0);
+  EXPECT_NEAR(cv::mean(bright.left)[0], 1.3 * cv::mean(dim.left)[0], 1.0);
+}
+
+TEST(SimRender, MotionBlurSmoothsTheImagesNotTheGroundTruth) {
+  const World& w = test::light_world();
+  RigConfig rig;
+  const Trajectory demo = Trajectory::demo_flight(w);
+  const StereoSimulation sharp(w, rig, demo);
+  rig.motion_blur_samples = 8;
+  rig.exposure_time = 0.05;
+  const StereoSimulation blurred(w, rig, demo);
+  const int k = 400;  // cruising along the survey loop
+  const StereoFrame a = sharp.frame(k), b = blurred.frame(k);
+  EXPECT_EQ(cv::norm(a.depth, b.depth, cv::NORM_INF), 0.0);
+  EXPECT_EQ(a.target_box, b.target_box);
+  auto gradient_energy = [](const cv::Mat& img) {
+    cv::Mat gx;
+    cv::Sobel(img, gx, CV_32F, 1, 0);
+    return cv::norm(gx, cv::NORM_L1);
+  };
+  EXPECT_LT(gradient_energy(b.left), 0.95 * gradient_energy(a.left));
+  EXPECT_LT(gradient_energy(b.right), 0.95 * gradient_energy(a.right));
+  EXPECT_NEAR(cv::mean(b.left)[0], cv::mean(a.left)[0], 2.0);  // same light
 }
 
 TEST(SimRender, TexturesGiveFastCornersEverywhere) {

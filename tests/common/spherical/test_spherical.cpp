@@ -109,7 +109,9 @@ TEST(Spherical, FullSphereGridCoversThePoles) {
 }
 
 TEST(Spherical, CameraGridCoversEveryPixel) {
-  const sp::SphericalEncoder enc(kCam, kSize);
+  sp::EncoderConfig cfg;
+  cfg.angular_resolution_rad = sp::deg_to_rad(0.5f);
+  const sp::SphericalEncoder enc(kCam, kSize, cfg);
   const auto& g = enc.grid();
   EXPECT_FLOAT_EQ(g.polar_step, sp::deg_to_rad(0.5f));
   // Horizontal field of view 2 atan(188 / 260) ~ 71.7 deg -> about 144 bins of 0.5 deg.
@@ -135,7 +137,9 @@ TEST(Spherical, SphereAroundTheCameraDecodesAtItsRadius) {
 }
 
 TEST(Spherical, PlaneDecodesOntoThePlane) {
-  const sp::SphericalEncoder enc(kCam, kSize);
+  sp::EncoderConfig cfg;
+  cfg.angular_resolution_rad = sp::deg_to_rad(0.5f);
+  const sp::SphericalEncoder enc(kCam, kSize, cfg);
   const float z = 3.f;
   const auto d = enc.encode_depth(cv::Mat(kSize, CV_32F, cv::Scalar(z)));
   ASSERT_GT(d.size(), 10000u);

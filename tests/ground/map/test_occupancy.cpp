@@ -6,7 +6,10 @@
 #include <fstream>
 #include <limits>
 
+#include <random>
+
 #include "ground/map/distance_map.hpp"
+#include "ground/map/key_ray.hpp"
 #include "ground/map/occupancy.hpp"
 #include "tests/ground/map/room_fixture.hpp"
 #include "tests/support/test_support.hpp"
@@ -92,7 +95,10 @@ TEST(Occupancy, MissOnAnOccludedVoxelCountsLess) {
 }
 
 TEST(Occupancy, StereoErrorModelWeightsFarHitsAndKeepsFreeSpaceOffTheSurface) {
-  m::OccupancyParams params;  // default stereo model: f = 260 px, b = 0.12 m, 0.5 px
+  m::OccupancyParams params;
+  params.stereo.focal_px = 260;
+  params.stereo.baseline_m = 0.12;
+  params.stereo.disparity_sigma_px = 0.5;
   m::OccupancyMap map(params);
   const Vector3f origin(0.05f, 0.05f, 0.05f);
   map.insert_frame({{1.05f, 0.05f, 0.05f}, {0.05f, 4.05f, 0.05f}}, origin);
@@ -226,7 +232,7 @@ TEST(Occupancy, SimulatedRoomIsReconstructedWithinOneVoxel) {
   // Distance map: from the camera position the nearest surface is the floor/wall geometry.
   m::DistanceMap distances(2.0);
   distances.update(map);
-  for (const Vector3d& p : {Vector3d(-1.0, 0.0, 1.2), Vector3d(-2.2, 1.5, 0.9), Vector3d(0.3, -0.1, 0.6)}) {
+  for (const Vector3d& p : {Vector3d(-2.4, 0.0, 1.2), Vector3d(-1.0, 1.9, 1.5), Vector3d(0.3, -0.1, 0.6)}) {
     const auto n = distances.nearest(p);
     const double truth = room.surface_distance(p);
     if (truth < 1.8) {
@@ -295,4 +301,29 @@ TEST(Occupancy, SaveLoadRoundTrip) {
   }
   std::ofstream(dir / "junk.bt") << "not a map";
   EXPECT_THROW(map.load((dir / "junk.bt").string()), std::runtime_error);
+}
+
+TEST(KeyRay, SameVoxelsAsOctoMapComputeRayKeys) {
+  octomap::OcTree tree(0.1);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-6.0, 6.0);
+  size_t rays = 0, differing = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Vector3d o(u(rng) * 0.3, u(rng) * 0.3, u(rng) * 0.3), e(u(rng), u(rng), u(rng));
+    octomap::KeyRay reference;
+    ASSERT_TRUE(tree.computeRayKeys(octomap::point3d(o.x(), o.y(), o.z()), octomap::point3d(e.x(), e.y(), e.z()), reference));
+    octomap::OcTreeKey end_key = tree.coordToKey(e.x(), e.y(), e.z());
+    std::vector<octomap::OcTreeKey> ours;
+    const double length = (e - o).norm();
+    m::traverse_keys(o, (e - o) / length, length, 0.1, 0, [&](const octomap::OcTreeKey& k, double, double) {
+      if (k == end_key) return false;
+      ours.push_back(k);
+      return true;
+    });
+    ++rays;
+    const std::vector<octomap::OcTreeKey> ref(reference.begin(), reference.end());
+    if (ref != ours) ++differing;
+  }
+  // Both are Amanatides & Woo; ties at voxel corners may be broken differently.
+  EXPECT_LE(differing, rays / 50) << differing << " of " << rays;
 }

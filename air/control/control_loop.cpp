@@ -1,0 +1,72 @@
+#include "air/control/control_loop.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "common/flc/pid_inputs.hpp"
+
+namespace aerie::control {
+
+void ControlConfig::validate() const {
+  if (!std::isfinite(reference_deg)) throw std::invalid_argument("control: reference_deg must be finite");
+  if (!(forward_speed_m_s >= 0.0 && forward_speed_m_s < 20.0)) throw std::invalid_argument("control: forward_speed_m_s must be in [0, 20)");
+  if (!(stale_timeout_s > 0.0)) throw std::invalid_argument("control: stale_timeout_s must be > 0");
+  if (!(limits.max_yaw_rate_deg_s > 0.0) || !(limits.max_yaw_accel_deg_s2 >= 0.0))
+    throw std::invalid_argument("control: max_yaw_rate_deg_s must be > 0 and max_yaw_accel_deg_s2 >= 0");
+}
+
+ControlLoop::ControlLoop(flc::FlcSpec controller, ControlConfig config)
+    : cfg_((config.validate(), config)), loop_(flc::Flc(std::move(controller)), cfg_.limits) {}
+
+bool ControlLoop::stale(int64_t now_us) const {
+  return !have_input_ || static_cast<double>(now_us - last_receive_) > cfg_.stale_timeout_s * 1e6;
+}
+
+bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us) {
+  if (!std::isfinite(heading_deg)) return false;
+  if (have_input_ && utime <= last_utime_) return false;
+  // Input resumed after going stale: the derivative and integral start afresh.
+  if (have_input_ && stale(receive_wall_us)) loop_.reset();
+  if (!have_reference_) {
+    reference_ = cfg_.reference_relative ? flc::wrap_deg(heading_deg + cfg_.reference_deg) : cfg_.reference_deg;
+    have_reference_ = true;
+  }
+  const double u = loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_);
+  have_input_ = true;
+  last_utime_ = utime;
+  last_receive_ = receive_wall_us;
+  active_.mode = Mode::kActive;
+  active_.yaw_rate_deg_s = u;
+  active_.forward_speed_m_s = cfg_.forward_speed_m_s;
+  active_.heading_deg = heading_deg;
+  active_.reference_deg = reference_;
+  active_.error_deg = loop_.inputs()[0];
+  active_.source_utime = utime;
+  return true;
+}
+
+std::optional<std::string> ControlLoop::set_controller(const flc::FlcSpec& spec) {
+  try {
+    loop_.set_controller(flc::Flc(spec));
+  } catch (const std::exception& e) {
+    return std::string(e.what());
+  }
+  return std::nullopt;
+}
+
+Command ControlLoop::command(int64_t now_us) const {
+  Command c = active_;
+  c.controller_id = controller().id;
+  if (!have_input_) {
+    c = Command{};
+    c.controller_id = controller().id;
+    c.mode = Mode::kHover;
+  } else if (stale(now_us)) {
+    c.mode = Mode::kFallbackHover;
+    c.yaw_rate_deg_s = 0.0;
+    c.forward_speed_m_s = 0.0;
+  }
+  return c;
+}
+
+}  // namespace aerie::control

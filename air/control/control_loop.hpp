@@ -1,0 +1,64 @@
+#pragma once
+// The onboard heading controller without LCM (thesis 5.1.2-5.1.3): heading
+// measurements in, FLC yaw-rate commands out, with command limits, a controller that
+// can be replaced at run time after validation, and a hover fallback when the input
+// goes stale.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "common/flc/flc.hpp"
+#include "common/flc/heading_loop.hpp"
+
+namespace aerie::control {
+
+enum class Mode : int8_t { kHover = 0, kActive = 1, kFallbackHover = 2 };  // = control_cmd_t constants
+
+struct ControlConfig {
+  double reference_deg = 90.0;        // heading reference (thesis: 90 deg, parallel to the wall)
+  bool reference_relative = true;     // reference is relative to the first heading received
+  double forward_speed_m_s = 0.0;     // forward speed commanded while active
+  double stale_timeout_s = 0.5;       // no heading for longer than this -> fallback hover
+  flc::CommandLimits limits;
+  void validate() const;              // throws std::invalid_argument
+};
+
+struct Command {
+  Mode mode = Mode::kHover;
+  double yaw_rate_deg_s = 0.0;
+  double forward_speed_m_s = 0.0;
+  double heading_deg = 0.0, reference_deg = 0.0, error_deg = 0.0;
+  int64_t source_utime = 0;           // utime of the heading the command derives from
+  std::string controller_id;
+};
+
+class ControlLoop {
+ public:
+  ControlLoop(flc::FlcSpec controller, ControlConfig config);
+
+  // A heading measurement: utime of its source frame (message time, drives the FLC's
+  // derivative and integral) and the wall-clock time it was received (for staleness).
+  // Returns false (and ignores it) if it is not newer than the last one or not finite.
+  bool on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us);
+
+  // Replaces the controller if it is valid; otherwise keeps the current one and
+  // returns the reason it was refused.
+  std::optional<std::string> set_controller(const flc::FlcSpec& spec);
+
+  // The command to send at wall-clock time now_us.
+  Command command(int64_t now_us) const;
+
+  const flc::FlcSpec& controller() const { return loop_.flc().spec(); }
+  const ControlConfig& config() const { return cfg_; }
+  bool stale(int64_t now_us) const;
+
+ private:
+  ControlConfig cfg_;
+  flc::HeadingLoop loop_;
+  bool have_input_ = false, have_reference_ = false;
+  double reference_ = 0.0;
+  int64_t last_utime_ = 0, last_receive_ = 0;
+  Command active_;
+};
+
+}  // namespace aerie::control

@@ -1,0 +1,128 @@
+#include "air/control/control_node.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+#include "common/bus/channels.hpp"
+#include "common/flc/flc_io.hpp"
+#include "common/util/time.hpp"
+
+namespace aerie::control {
+
+flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::FlcSpec& current) {
+  const std::string origin = "FLC_PARAMS '" + m.controller_id + "'";
+  flc::FlcSpec spec;
+  try {
+    spec = m.fll.empty() ? current : flc::parse_fll(m.fll, origin + " fll");
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(e.what());
+  }
+  if (m.names.size() != m.values.size()) throw std::invalid_argument(origin + ": names and values differ in length");
+  if (m.fll.empty() && m.names.empty()) throw std::invalid_argument(origin + ": neither an FLL nor parameters");
+  for (size_t i = 0; i < m.names.size(); ++i) {
+    if (!std::isfinite(m.values[i])) throw std::invalid_argument(origin + ": parameter '" + m.names[i] + "' is not finite");
+    try {
+      spec.set_parameter(m.names[i], m.values[i]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(origin + ": " + e.what());
+    }
+  }
+  if (!m.controller_id.empty()) spec.id = m.controller_id;
+  try {
+    spec.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(origin + ": " + e.what());
+  }
+  return spec;
+}
+
+ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options)
+    : bus_(bus), status_(status), opt_(std::move(options)), loop_(std::move(controller), opt_.control) {
+  if (!(opt_.rate_hz > 0.0 && opt_.rate_hz <= 1000.0)) throw std::invalid_argument("control: rate_hz must be in (0, 1000]");
+  opt_.frame.validate();
+  period_us_ = static_cast<int64_t>(1e6 / opt_.rate_hz);
+  const bool vo = opt_.input == NodeOptions::Input::kVoPose;
+  if (opt_.pose_channel.empty()) opt_.pose_channel = vo ? channels::kVoPose : channels::kGtPose;
+  if (vo) {
+    bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo& info) {
+      if (m.status != aerie::pose_t::OK) {
+        status_.count("pose_not_ok");  // initialising/lost: no heading, the fallback takes over when stale
+        return;
+      }
+      on_heading(m.utime, heading_from_quaternion(m.orientation, opt_.frame), info.recv_utime);
+    });
+  } else {
+    bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo& info) {
+      on_heading(m.utime, heading_from_quaternion(m.orientation, opt_.frame), info.recv_utime);
+    });
+  }
+  bus_.subscribe<aerie::flc_params_t>(opt_.params_channel,
+                                      [this](const aerie::flc_params_t& m, const bus::ReceiveInfo&) { on_params(m); });
+  status_.ok("controller " + loop_.controller().id);
+}
+
+void ControlNode::on_heading(int64_t utime, double heading_deg, int64_t receive_us) {
+  if (!loop_.on_heading(utime, heading_deg, receive_us)) {
+    status_.count("pose_out_of_order");
+    return;
+  }
+  status_.count("poses");
+  last_receive_ = receive_us;
+  if (stale_reported_) {
+    status_.ok("input resumed; controller " + loop_.controller().id);
+    stale_reported_ = false;
+  }
+}
+
+void ControlNode::on_params(const aerie::flc_params_t& m) {
+  std::string reason;
+  try {
+    const auto refused = loop_.set_controller(controller_from_message(m, loop_.controller()));
+    if (refused) reason = *refused;
+  } catch (const std::exception& e) {
+    reason = e.what();
+  }
+  if (!reason.empty()) {
+    status_.count("params_refused");
+    status_.warn("refused controller '" + m.controller_id + "': " + reason + " (keeping '" + loop_.controller().id + "')");
+    spdlog::warn("refused controller '{}': {} (keeping '{}')", m.controller_id, reason, loop_.controller().id);
+    return;
+  }
+  status_.count("params_accepted");
+  status_.ok("controller " + loop_.controller().id);
+  spdlog::info("controller '{}' in use ({} rules)", loop_.controller().id, loop_.controller().rules.size());
+}
+
+void ControlNode::tick(int64_t now_us) {
+  if (now_us < next_publish_) return;
+  publish_command(now_us);
+  // Keep the fixed rate; after a long pause start again from now.
+  next_publish_ = now_us - next_publish_ > period_us_ ? now_us + period_us_ : next_publish_ + period_us_;
+}
+
+void ControlNode::publish_command(int64_t now_us) {
+  const Command c = loop_.command(now_us);
+  aerie::control_cmd_t m;
+  m.utime = c.source_utime;
+  m.seq = seq_++;
+  m.mode = static_cast<int8_t>(c.mode);
+  m.controller_id = c.controller_id;
+  m.yaw_rate_deg_s = static_cast<float>(c.yaw_rate_deg_s);
+  m.velocity_body[0] = static_cast<float>(c.forward_speed_m_s);
+  m.velocity_body[1] = 0.0f;
+  m.velocity_body[2] = 0.0f;
+  m.heading_deg = static_cast<float>(c.heading_deg);
+  m.heading_ref_deg = static_cast<float>(c.reference_deg);
+  m.heading_error_deg = static_cast<float>(c.error_deg);
+  bus_.publish(opt_.command_channel, m);
+  status_.count(c.mode == Mode::kActive ? "commands_active" : c.mode == Mode::kHover ? "commands_hover" : "commands_fallback");
+  if (c.mode == Mode::kFallbackHover && !stale_reported_) {
+    status_.warn("no heading for more than " + std::to_string(opt_.control.stale_timeout_s) + " s: hovering");
+    spdlog::warn("input stale: fallback hover");
+    stale_reported_ = true;
+  }
+  status_.mark_hop(c.source_utime, last_receive_, util::wall_utime());
+}
+
+}  // namespace aerie::control

@@ -1,0 +1,55 @@
+#pragma once
+// aerie-control's LCM side: VO_POSE (or GT_POSE) in, CTRL_CMD out at a fixed rate,
+// new controllers from FLC_PARAMS (validated; a bad one is refused with its reason
+// and the current one stays), status on STATUS_CONTROL.
+#include <aerie/control_cmd_t.hpp>
+#include <aerie/flc_params_t.hpp>
+#include <aerie/gt_pose_t.hpp>
+#include <aerie/pose_t.hpp>
+
+#include <string>
+
+#include "air/control/control_loop.hpp"
+#include "air/control/heading_from_pose.hpp"
+#include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
+
+namespace aerie::control {
+
+struct NodeOptions {
+  enum class Input { kVoPose, kGtPose };
+  Input input = Input::kVoPose;
+  std::string pose_channel;           // "" = VO_POSE or GT_POSE by input
+  std::string params_channel = "FLC_PARAMS";
+  std::string command_channel = "CTRL_CMD";
+  double rate_hz = 30.0;              // CTRL_CMD rate
+  HeadingFrame frame;
+  ControlConfig control;
+};
+
+// The controller a FLC_PARAMS message describes: its FLL if it has one, else the
+// current controller; then its named parameters; its id. Throws with the reason.
+flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::FlcSpec& current);
+
+class ControlNode {
+ public:
+  ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options);
+
+  // Publishes a command when a period of the rate has elapsed since the last one.
+  void tick(int64_t now_us);
+  void publish_command(int64_t now_us);
+  const ControlLoop& loop() const { return loop_; }
+
+ private:
+  void on_heading(int64_t utime, double heading_deg, int64_t receive_us);
+  void on_params(const aerie::flc_params_t& m);
+
+  bus::Bus& bus_;
+  bus::StatusReporter& status_;
+  NodeOptions opt_;
+  ControlLoop loop_;
+  int64_t seq_ = 0, next_publish_ = 0, period_us_ = 0, last_receive_ = 0;
+  bool stale_reported_ = false;
+};
+
+}  // namespace aerie::control

@@ -1,0 +1,55 @@
+// aerie-control: the onboard heading controller (thesis 5.1.2-5.1.3, 5.1.6). Runs the
+// FLC on the heading from VO_POSE (or GT_POSE in simulation) against the reference,
+// publishes CTRL_CMD at a fixed rate, takes new controllers from FLC_PARAMS, hovers
+// when its input goes stale. Status on STATUS_CONTROL.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+
+#include "air/control/control_config.hpp"
+#include "air/control/control_node.hpp"
+#include "common/bus/node.hpp"
+#include "common/flc/flc_io.hpp"
+#include "common/util/cli.hpp"
+#include "common/util/time.hpp"
+
+using namespace aerie;
+
+int main(int argc, char** argv) {
+  CLI::App app{"aerie-control: fuzzy heading controller (VO_POSE/GT_POSE -> CTRL_CMD, FLC_PARAMS at run time)"};
+  util::CommonOptions common;
+  util::add_common_options(app, common);
+  control::CliOverrides cli;
+  app.add_option("--controller", cli.controller, "controller file (.yaml or .fll); default: config or the thesis' initial FLC");
+  app.add_option("--input", cli.input, "heading source: vo (VO_POSE, aerie.pose_t) or gt (GT_POSE, aerie.gt_pose_t)")
+      ->check(CLI::IsMember({"vo", "gt"}));
+  app.add_option("--pose-channel", cli.pose_channel, "pose channel (default VO_POSE or GT_POSE)");
+  app.add_option("--reference", cli.reference_deg, "heading reference in degrees");
+  app.add_option("--speed", cli.forward_speed, "forward speed commanded while active (m/s)");
+  app.add_option("--rate", cli.rate_hz, "CTRL_CMD rate (Hz)");
+  app.add_option("--stale-timeout", cli.stale_timeout_s, "hover when no heading for this long (s)");
+  CLI11_PARSE(app, argc, argv);
+  util::init_logging("control", common.log_level);
+  try {
+    const util::Config cfg = common.config.empty() ? util::Config() : util::Config::load(common.config);
+    const control::NodeSetup setup = control::node_setup(cfg, cli);
+    bus::Bus bus(common.lcm_url);
+    bus::StatusReporter status(bus, "control");
+    control::ControlNode node(bus, status, setup.controller, setup.options);
+    spdlog::info("controller '{}' ({} rules), input {} on {}, CTRL_CMD at {} Hz, reference {} deg{}, stale after {} s",
+                 setup.controller.id, setup.controller.rules.size(),
+                 setup.options.input == control::NodeOptions::Input::kVoPose ? "vo" : "gt",
+                 setup.options.pose_channel, setup.options.rate_hz,
+                 setup.options.control.reference_deg, setup.options.control.reference_relative ? " (relative)" : "",
+                 setup.options.control.stale_timeout_s);
+    bus::run(bus, status, [&] {
+      node.tick(util::wall_utime());
+      return true;
+    }, 2);
+    spdlog::info("stopped");
+    return 0;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,257 @@
+#include "air/track/factory.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <opencv2/tracking.hpp>
+#include <opencv2/tracking/tracking_legacy.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <set>
+#include <stdexcept>
+
+#include "air/track/ct/ct.hpp"
+#ifdef AERIE_HAVE_IPSL
+#include "air/track/ipsl/ipsl.hpp"
+#endif
+#include "air/track/mil/mil.hpp"
+#include "air/track/pyramid/discriminative.hpp"
+
+namespace aerie::track {
+namespace {
+
+// Reads keys of one tracker section and rejects any key it does not know.
+class Params {
+ public:
+  Params(const util::Config& cfg, std::string tracker) : cfg_(cfg), tracker_(std::move(tracker)) {}
+  template <typename T>
+  void read(const std::string& key, T& value) {
+    known_.insert(key);
+    value = cfg_.get<T>(key, value);
+  }
+  void read_list(const std::string& key, std::vector<double>& value) {
+    known_.insert(key);
+    if (!cfg_.has(key)) return;
+    if (cfg_.node()[key].IsScalar())
+      value = {cfg_.get<double>(key, 0.0)};
+    else
+      value = cfg_.get<std::vector<double>>(key, value);
+  }
+  void check_unknown() const {
+    if (!cfg_.node().IsMap()) return;
+    for (const auto& kv : cfg_.node()) {
+      const auto key = kv.first.as<std::string>();
+      if (!known_.count(key))
+        throw std::invalid_argument(cfg_.origin() + ": unknown parameter '" + key + "' for tracker '" + tracker_ + "'");
+    }
+  }
+
+ private:
+  const util::Config& cfg_;
+  std::string tracker_;
+  std::set<std::string> known_;
+};
+
+DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
+  in.read("channels", p.channels);
+  in.read("max_levels", p.max_levels);
+  in.read("min_size", p.min_size);
+  in.read("search_radius", p.search_radius);
+  in.read("coarse_radius", p.coarse_radius);
+  in.read("pos_radius", p.pos_radius);
+  in.read("neg_inner", p.neg_inner);
+  in.read("neg_outer", p.neg_outer);
+  in.read("neg_count", p.neg_count);
+  in.read("min_pos_radius", p.min_pos_radius);
+  in.read_list("reject_ratio", p.reject_ratio);
+  in.read("min_radius", p.min_radius);
+  in.read("max_radius", p.max_radius);
+  in.read("scale_estimation", p.scale_estimation);
+  in.read("scale_step", p.scale_step);
+  in.read("max_scale_change", p.max_scale_change);
+  in.read("min_scale", p.min_scale);
+  in.read("max_scale", p.max_scale);
+  in.read("redetection", p.redetection);
+  in.read("confidence_rate", p.confidence_rate);
+  in.read("lost_frames", p.lost_frames);
+  in.read("found_confidence", p.found_confidence);
+  in.read("redetect_stride", p.redetect_stride);
+  in.read("update_confidence", p.update_confidence);
+  return p;
+}
+
+double read_density_floor(Params& in) {
+  double floor = 1e-30;
+  in.read("density_floor", floor);
+  if (!(floor > 0)) throw std::invalid_argument("density_floor must be > 0");
+  return std::log(floor);
+}
+
+// Defaults of the single-resolution trackers (the published settings) and of the
+// multi-resolution ones (thesis: 3 levels, coarsest radius 5 for a full-resolution 20).
+DiscriminativeParams single_resolution() {
+  DiscriminativeParams p;
+  p.max_levels = 1;
+  return p;
+}
+DiscriminativeParams multi_resolution() {
+  DiscriminativeParams p;
+  p.max_levels = 3;
+  return p;
+}
+
+std::unique_ptr<Tracker> make_ct(const std::string& name, const util::Config& cfg, uint64_t seed,
+                                 DiscriminativeParams defaults) {
+  Params in(cfg, name);
+  CtParams ct;
+  in.read("features", ct.features);
+  in.read("min_rects", ct.min_rects);
+  in.read("max_rects", ct.max_rects);
+  in.read("learning_rate", ct.learning_rate);
+  in.read("sigma_min", ct.sigma_min);
+  ct.log_floor = read_density_floor(in);
+  const DiscriminativeParams d = read_discriminative(in, defaults);
+  in.check_unknown();
+  return std::make_unique<DiscriminativeTracker>(name, d, ct_classifier_factory(ct), seed);
+}
+
+std::unique_ptr<Tracker> make_mil(const std::string& name, const util::Config& cfg, uint64_t seed,
+                                  DiscriminativeParams defaults) {
+  Params in(cfg, name);
+  MilParams mil;
+  in.read("features", mil.features);
+  in.read("selected", mil.selected);
+  in.read("min_rects", mil.min_rects);
+  in.read("max_rects", mil.max_rects);
+  in.read("learning_rate", mil.learning_rate);
+  in.read("sigma_min", mil.sigma_min);
+  mil.log_floor = read_density_floor(in);
+  const DiscriminativeParams d = read_discriminative(in, defaults);
+  in.check_unknown();
+  return std::make_unique<DiscriminativeTracker>(name, d, mil_classifier_factory(mil), seed);
+}
+
+// OpenCV's trackers behind the Aerie interface. On a failed update the box stays where it
+// was and the state says lost (OTB protocol: a box for every frame).
+class OpenCvTracker : public Tracker {
+ public:
+  using Init = std::function<void(const cv::Mat&, const cv::Rect2d&)>;
+  using Update = std::function<bool(const cv::Mat&, cv::Rect2d&)>;
+  OpenCvTracker(std::string name, std::function<std::pair<Init, Update>()> make)
+      : name_(std::move(name)), make_(std::move(make)) {}
+
+  std::string name() const override { return name_; }
+  void init(const cv::Mat& frame, const cv::Rect2d& box) override {
+    validate_init(frame, box);
+    std::tie(init_, update_) = make_();
+    init_(frame, box);
+    box_ = box;
+    size_ = frame.size();
+    initial_ = box.size();
+  }
+  TrackState update(const cv::Mat& frame) override {
+    if (!update_) throw std::invalid_argument(name_ + ": update() before init()");
+    if (frame.empty() || frame.size() != size_) throw std::invalid_argument(name_ + ": empty frame or frame size changed");
+    cv::Rect2d b = box_;
+    const bool ok = update_(frame, b);
+    TrackState s;
+    if (ok && b.width > 0 && b.height > 0 && std::isfinite(b.x) && std::isfinite(b.y)) box_ = b;
+    s.initial_size = initial_;
+    s.pose = {box_.x + box_.width / 2, box_.y + box_.height / 2, std::sqrt(box_.area() / initial_.area()), 0.0};
+    s.initial_size = cv::Size2d(box_.width, box_.height) / s.pose.scale;  // keep the aspect ratio OpenCV reports
+    s.confidence = ok ? 1.0 : 0.0;
+    s.lost = !ok;
+    return s;
+  }
+
+ private:
+  std::string name_;
+  std::function<std::pair<Init, Update>()> make_;
+  Init init_;
+  Update update_;
+  cv::Rect2d box_;
+  cv::Size size_;
+  cv::Size2d initial_;
+};
+
+template <typename T>
+std::pair<OpenCvTracker::Init, OpenCvTracker::Update> modern(cv::Ptr<T> t) {
+  return {[t](const cv::Mat& f, const cv::Rect2d& b) { t->init(f, cv::Rect(b)); },
+          [t](const cv::Mat& f, cv::Rect2d& b) {
+            cv::Rect r(b);
+            const bool ok = t->update(f, r);
+            b = r;
+            return ok;
+          }};
+}
+
+template <typename T>
+std::pair<OpenCvTracker::Init, OpenCvTracker::Update> legacy(cv::Ptr<T> t) {
+  return {[t](const cv::Mat& f, const cv::Rect2d& b) { t->init(f, b); },
+          [t](const cv::Mat& f, cv::Rect2d& b) { return t->update(f, b); }};
+}
+
+using Maker = std::function<std::unique_ptr<Tracker>(const util::Config&, uint64_t)>;
+
+const std::vector<std::pair<std::string, Maker>>& registry() {
+  static const std::vector<std::pair<std::string, Maker>> r = [] {
+    std::vector<std::pair<std::string, Maker>> v;
+#ifdef AERIE_HAVE_IPSL
+    v.emplace_back("ipsl", [](const util::Config& c, uint64_t s) -> std::unique_ptr<Tracker> {
+      return std::make_unique<IpslTracker>(ipsl_params_from_config(c), s);
+    });
+    v.emplace_back("ipsl-mr", [](const util::Config& c, uint64_t s) -> std::unique_ptr<Tracker> {
+      return std::make_unique<HierarchicalIpslTracker>(hierarchical_ipsl_params_from_config(c), s);
+    });
+#endif
+    v.emplace_back("ct", [](const util::Config& c, uint64_t s) { return make_ct("ct", c, s, single_resolution()); });
+    v.emplace_back("amcmr-ct",
+                   [](const util::Config& c, uint64_t s) { return make_ct("amcmr-ct", c, s, multi_resolution()); });
+    v.emplace_back("mil", [](const util::Config& c, uint64_t s) { return make_mil("mil", c, s, single_resolution()); });
+    v.emplace_back("am3", [](const util::Config& c, uint64_t s) { return make_mil("am3", c, s, multi_resolution()); });
+    auto reference = [&v](const std::string& name, std::function<std::pair<OpenCvTracker::Init, OpenCvTracker::Update>()> f) {
+      v.emplace_back(name, [name, f](const util::Config& c, uint64_t) -> std::unique_ptr<Tracker> {
+        Params(c, name).check_unknown();  // OpenCV defaults only
+        return std::make_unique<OpenCvTracker>(name, f);
+      });
+    };
+    reference("opencv-mil", [] { return modern(cv::TrackerMIL::create()); });
+    reference("opencv-kcf", [] { return modern(cv::TrackerKCF::create()); });
+    reference("opencv-csrt", [] { return modern(cv::TrackerCSRT::create()); });
+    reference("opencv-tld", [] { return legacy(cv::legacy::TrackerTLD::create()); });
+    reference("opencv-medianflow", [] { return legacy(cv::legacy::TrackerMedianFlow::create()); });
+    reference("opencv-boosting", [] { return legacy(cv::legacy::TrackerBoosting::create()); });
+    reference("opencv-mosse", [] { return legacy(cv::legacy::TrackerMOSSE::create()); });
+    return v;
+  }();
+  return r;
+}
+
+}  // namespace
+
+std::vector<std::string> aerie_tracker_names() {
+  std::vector<std::string> out;
+  for (const auto& [name, make] : registry())
+    if (name.rfind("opencv-", 0) != 0) out.push_back(name);
+  return out;
+}
+
+std::vector<std::string> opencv_tracker_names() {
+  std::vector<std::string> out;
+  for (const auto& [name, make] : registry())
+    if (name.rfind("opencv-", 0) == 0) out.push_back(name);
+  return out;
+}
+
+bool is_known_tracker(const std::string& name) {
+  const auto& r = registry();
+  return std::any_of(r.begin(), r.end(), [&](const auto& e) { return e.first == name; });
+}
+
+std::unique_ptr<Tracker> make_tracker(const std::string& name, const util::Config& params, uint64_t seed) {
+  for (const auto& [n, make] : registry())
+    if (n == name) return make(params, seed);
+  std::string known;
+  for (const auto& [n, make] : registry()) known += (known.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown tracker '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace aerie::track

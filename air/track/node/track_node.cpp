@@ -1,0 +1,386 @@
+#include "air/track/node/track_node.hpp"
+
+#include <aerie/target_pose_t.hpp>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "air/track/factory.hpp"
+#include "common/camera/calibration_io.hpp"
+#include "common/image/image_message.hpp"
+#include "common/util/time.hpp"
+
+namespace aerie::track {
+
+NodeOptions node_options(const util::Config& cfg) {
+  NodeOptions o;
+  const util::Config node = cfg.section("node");
+  o.camera_channel = node.get("camera_channel", o.camera_channel);
+  o.stereo = node.get("stereo", o.stereo);
+  o.command_channel = node.get("command_channel", o.command_channel);
+  o.track_channel = node.get("track_channel", o.track_channel);
+  o.pose_channel = node.get("pose_channel", o.pose_channel);
+  o.gt_channel = node.get("gt_channel", o.gt_channel);
+  o.tracker = node.get("tracker", o.tracker);
+  o.seed = node.get<uint64_t>("seed", o.seed);
+  o.max_points = node.get("max_points", o.max_points);
+  o.init_from_gt = node.get("init_from_gt", o.init_from_gt);
+  if (!is_known_tracker(o.tracker))
+    throw std::runtime_error(cfg.origin() + ": node.tracker: unknown tracker '" + o.tracker + "'");
+  if (o.max_points < 0) throw std::runtime_error(cfg.origin() + ": node.max_points must be >= 0");
+
+  const util::Config target = cfg.section("target");
+  o.target_name = target.get("name", o.target_name);
+  o.target.width_m = target.get("width_m", 0.0);
+  o.target.height_m = target.get("height_m", o.target.width_m);
+  o.target.yaw_offset = target.get("yaw_offset_deg", 0.0) * M_PI / 180;
+  if (o.target.width_m < 0 || o.target.height_m < 0)
+    throw std::runtime_error(cfg.origin() + ": target.width_m and target.height_m must be >= 0");
+
+  const util::Config cam = cfg.section("camera");
+  if (cam.has("calibration")) {
+    o.camera = camera::read_stereo_calibration(cam.require<std::string>("calibration")).left;
+  } else if (cam.get("fx", 0.0) > 0) {
+    camera::CameraModel m;
+    m.fx = cam.require<double>("fx");
+    m.fy = cam.get("fy", m.fx);
+    m.cx = cam.require<double>("cx");
+    m.cy = cam.require<double>("cy");
+    m.width = cam.get("width", 0);
+    m.height = cam.get("height", 0);
+    o.camera = m;
+  }
+  o.trackers = cfg.section("trackers");
+  return o;
+}
+
+TrackNode::TrackNode(bus::Bus& bus, NodeOptions options) : bus_(bus), opt_(std::move(options)) {
+  if (!is_known_tracker(opt_.tracker)) throw std::invalid_argument("unknown tracker '" + opt_.tracker + "'");
+  tracker_params_ = opt_.trackers.section(opt_.tracker);
+  if (opt_.stereo) {
+    bus_.subscribe<aerie::stereo_image_t>(opt_.camera_channel, [this](const aerie::stereo_image_t& m,
+                                                                      const bus::ReceiveInfo& info) {
+      camera::CameraModel c;
+      c.width = m.left.width;
+      c.height = m.left.height;
+      c.fx = m.fx, c.fy = m.fy, c.cx = m.cx, c.cy = m.cy;
+      on_frame({m.left, info.recv_utime, c});
+    });
+  } else {
+    bus_.subscribe<aerie::image_t>(opt_.camera_channel, [this](const aerie::image_t& m, const bus::ReceiveInfo& info) {
+      on_frame({m, info.recv_utime, std::nullopt});
+    });
+  }
+  bus_.subscribe<aerie::track_cmd_t>(opt_.command_channel,
+                                     [this](const aerie::track_cmd_t& m, const bus::ReceiveInfo&) { on_command(m); });
+  if (opt_.init_from_gt >= 0)
+    bus_.subscribe<aerie::gt_box_t>(opt_.gt_channel, [this](const aerie::gt_box_t& m, const bus::ReceiveInfo&) { on_gt(m); });
+  worker_ = std::thread([this] { run(); });
+}
+
+TrackNode::~TrackNode() {
+  {
+    std::lock_guard lk(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  worker_.join();
+}
+
+void TrackNode::on_frame(Frame frame) {
+  std::lock_guard lk(mutex_);
+  ++counters_["frames_received"];
+  if (pending_) ++counters_["frames_skipped"];  // latest-frame semantics: the older one is dropped
+  pending_ = std::move(frame);
+  wake_.notify_one();
+}
+
+void TrackNode::on_command(const aerie::track_cmd_t& cmd) {
+  std::lock_guard lk(mutex_);
+  ++counters_["commands"];
+  commands_.push_back(cmd);
+  wake_.notify_one();
+}
+
+void TrackNode::on_gt(const aerie::gt_box_t& gt) {
+  std::lock_guard lk(mutex_);
+  gt_.push_back(gt);
+  if (gt_.size() > 64) gt_.pop_front();
+}
+
+void TrackNode::count(const std::string& name, int64_t n) {
+  std::lock_guard lk(mutex_);
+  counters_[name] += n;
+}
+
+void TrackNode::fail(const std::string& message) {
+  spdlog::warn("{}", message);
+  std::lock_guard lk(mutex_);
+  error_ = message;
+  error_fresh_ = true;
+}
+
+int64_t TrackNode::counter(const std::string& name) const {
+  std::lock_guard lk(mutex_);
+  const auto it = counters_.find(name);
+  return it == counters_.end() ? 0 : it->second;
+}
+
+void TrackNode::report(bus::StatusReporter& status) {
+  std::lock_guard lk(mutex_);
+  for (const auto& [name, value] : counters_) status.set(name, value);
+  if (error_fresh_) {
+    status.warn(error_);
+    error_fresh_ = false;
+  } else if (!error_.empty() && counters_["frames_processed"] == 0) {
+    status.warn(error_);
+  } else {
+    status.ok(tracker_name_.empty() ? "idle" : "tracking with " + tracker_name_);
+  }
+  if (hop_source_ != 0) status.mark_hop(hop_source_, hop_receive_, hop_publish_);
+}
+
+bool TrackNode::wait_idle(int timeout_ms) {
+  std::unique_lock lk(mutex_);
+  return idle_.wait_for(lk, std::chrono::milliseconds(timeout_ms),
+                        [&] { return !busy_ && !pending_ && commands_.empty(); });
+}
+
+void TrackNode::run() {
+  while (true) {
+    std::deque<aerie::track_cmd_t> cmds;
+    std::optional<Frame> frame;
+    {
+      std::unique_lock lk(mutex_);
+      wake_.wait(lk, [&] { return stop_ || pending_ || !commands_.empty(); });
+      if (stop_) return;
+      cmds.swap(commands_);
+      frame.swap(pending_);
+      busy_ = true;
+    }
+    bool initialised_now = false;
+    if (frame) {
+      try {
+        last_frame_ = image::from_message(frame->image);
+        last_camera_ = frame->camera ? frame->camera : opt_.camera;
+        ++frames_seen_;
+      } catch (const std::exception& e) {
+        count("decode_errors");
+        fail(opt_.camera_channel + ": " + e.what());
+        frame.reset();
+      }
+    }
+    if (!last_frame_.empty()) {  // INIT commands that came before the first frame
+      cmds.insert(cmds.begin(), deferred_.begin(), deferred_.end());
+      deferred_.clear();
+    }
+    for (const auto& cmd : cmds) {
+      try {
+        if (cmd.command == aerie::track_cmd_t::INIT && last_frame_.empty()) {
+          deferred_.push_back(cmd);
+          continue;
+        }
+        execute(cmd);
+        initialised_now |= cmd.command != aerie::track_cmd_t::STOP && tracker_ != nullptr;
+      } catch (const std::exception& e) {
+        count("command_errors");
+        fail(opt_.command_channel + ": " + e.what());
+      }
+    }
+    if (frame && opt_.init_from_gt >= 0 && !gt_init_done_ && !tracker_ && frames_seen_ > opt_.init_from_gt) {
+      std::optional<aerie::gt_box_t> gt;
+      {
+        std::lock_guard lk(mutex_);
+        for (const auto& g : gt_)  // the box of this frame, else the newest one before it
+          if (g.visible && g.utime <= frame->image.utime && (!gt || g.utime >= gt->utime)) gt = g;
+      }
+      if (gt) {
+        try {
+          start_tracker(opt_.tracker, opt_.trackers.section(opt_.tracker), {gt->x, gt->y, gt->width, gt->height});
+          gt_init_done_ = initialised_now = true;
+          spdlog::info("initialised {} on the {} box from {}", opt_.tracker, gt->target, opt_.gt_channel);
+        } catch (const std::exception& e) {
+          count("command_errors");
+          fail(opt_.gt_channel + ": " + e.what());
+          gt_init_done_ = true;
+        }
+      }
+    }
+    if (frame) {
+      if (initialised_now && tracker_) {
+        TrackState s;  // the frame the tracker was initialised on: the box itself
+        s.initial_size = last_box_.size();
+        s.pose = {last_box_.x + last_box_.width / 2, last_box_.y + last_box_.height / 2, 1, 0};
+        s.confidence = 1;
+        publish(*frame, &s, 0);
+      } else {
+        process(*frame);
+      }
+    }
+    {
+      std::lock_guard lk(mutex_);
+      busy_ = false;
+    }
+    idle_.notify_all();
+  }
+}
+
+void TrackNode::start_tracker(const std::string& name, const util::Config& params, const cv::Rect2d& box) {
+  if (last_frame_.empty()) throw std::invalid_argument("no camera frame yet on " + opt_.camera_channel);
+  auto t = make_tracker(name, params, opt_.seed);
+  t->init(last_frame_, box);
+  tracker_ = std::move(t);
+  tracker_name_ = name;
+  tracker_params_ = params;
+  last_box_ = box;
+}
+
+namespace {
+// The tracker's YAML section with the command's name = value overrides (values parsed as YAML).
+util::Config with_overrides(const util::Config& trackers, const std::string& name, const aerie::track_cmd_t& cmd) {
+  YAML::Node n = trackers.section(name).node().IsMap() ? YAML::Clone(trackers.section(name).node()) : YAML::Node(YAML::NodeType::Map);
+  if (cmd.nparams != static_cast<int>(cmd.param_names.size()) || cmd.param_names.size() != cmd.param_values.size())
+    throw std::invalid_argument("nparams does not match the parameter arrays");
+  for (size_t i = 0; i < cmd.param_names.size(); ++i) n[cmd.param_names[i]] = YAML::Load(cmd.param_values[i]);
+  YAML::Emitter out;
+  out << n;
+  return util::Config::parse(out.c_str(), "TRACK_CMD parameters of " + name);
+}
+}  // namespace
+
+void TrackNode::execute(const aerie::track_cmd_t& cmd) {
+  if (!cmd.camera.empty() && cmd.camera != opt_.camera_channel)
+    throw std::invalid_argument("command for camera " + cmd.camera + ", this tracker follows " + opt_.camera_channel);
+  const std::string name = !cmd.tracker.empty() ? cmd.tracker : !tracker_name_.empty() ? tracker_name_ : opt_.tracker;
+  switch (cmd.command) {
+    case aerie::track_cmd_t::INIT:
+      start_tracker(name, with_overrides(opt_.trackers, name, cmd), {cmd.x, cmd.y, cmd.width, cmd.height});
+      spdlog::info("INIT {} on ({:.0f}, {:.0f}, {:.0f}, {:.0f})", name, cmd.x, cmd.y, cmd.width, cmd.height);
+      break;
+    case aerie::track_cmd_t::STOP:
+      tracker_.reset();
+      tracker_name_.clear();
+      spdlog::info("STOP");
+      break;
+    case aerie::track_cmd_t::RESET:
+      if (!tracker_) throw std::invalid_argument("RESET while not tracking");
+      start_tracker(tracker_name_, tracker_params_, last_box_);  // forget the learned model, keep the box
+      spdlog::info("RESET {} at ({:.0f}, {:.0f})", tracker_name_, last_box_.x, last_box_.y);
+      break;
+    case aerie::track_cmd_t::SET_TRACKER: {
+      if (cmd.tracker.empty()) throw std::invalid_argument("SET_TRACKER without a tracker name");
+      const util::Config params = with_overrides(opt_.trackers, cmd.tracker, cmd);
+      make_tracker(cmd.tracker, params, opt_.seed);  // validates name and parameters
+      if (tracker_) {
+        start_tracker(cmd.tracker, params, last_box_);
+      } else {
+        opt_.tracker = cmd.tracker;
+        opt_.trackers = [&] {  // the overrides become the defaults of the next INIT
+          YAML::Node all = opt_.trackers.node().IsMap() ? YAML::Clone(opt_.trackers.node()) : YAML::Node(YAML::NodeType::Map);
+          all[cmd.tracker] = YAML::Clone(params.node());
+          YAML::Emitter out;
+          out << all;
+          return util::Config::parse(out.c_str(), opt_.trackers.origin());
+        }();
+      }
+      spdlog::info("SET_TRACKER {}", cmd.tracker);
+      break;
+    }
+    default:
+      throw std::invalid_argument("unknown command " + std::to_string(cmd.command));
+  }
+}
+
+void TrackNode::process(const Frame& frame) {
+  if (!tracker_) {
+    publish(frame, nullptr, 0);
+    return;
+  }
+  const util::Stopwatch sw;
+  try {
+    const TrackState s = tracker_->update(last_frame_);
+    const double ms = sw.ms();
+    if (!s.lost) last_box_ = s.box();
+    count("frames_processed");
+    if (s.lost) count("lost_frames");
+    if (s.redetected) count("redetections");
+    publish(frame, &s, ms);
+  } catch (const std::exception& e) {
+    count("track_errors");
+    fail(tracker_name_ + ": " + e.what() + " (tracking stopped)");
+    tracker_.reset();
+    tracker_name_.clear();
+    publish(frame, nullptr, sw.ms());
+  }
+}
+
+void TrackNode::publish(const Frame& frame, const TrackState* s, double ms) {
+  aerie::track_t m{};
+  m.utime = frame.image.utime;
+  m.seq = seq_++;
+  m.tracker = tracker_name_;
+  m.camera = opt_.camera_channel;
+  m.processing_ms = static_cast<float>(ms);
+  m.frames_skipped = counter("frames_skipped");
+  if (!s) {
+    m.status = aerie::track_t::IDLE;
+  } else {
+    m.status = s->lost ? aerie::track_t::LOST : s->redetected ? aerie::track_t::REDETECTED : aerie::track_t::TRACKING;
+    m.x = s->pose.x;
+    m.y = s->pose.y;
+    m.scale = s->pose.scale;
+    m.theta = s->pose.theta;
+    m.width = s->size().width;
+    m.height = s->size().height;
+    const auto c = s->corners();
+    for (int i = 0; i < 4; ++i) {
+      m.corners[i][0] = c[i].x;
+      m.corners[i][1] = c[i].y;
+    }
+    m.confidence = static_cast<float>(s->confidence);
+    for (const auto& l : s->levels) {
+      aerie::track_level_t tl{};
+      tl.level = l.level;
+      tl.evaluated = l.evaluated;
+      tl.rejected = l.rejected;
+      tl.search_radius = l.search_radius;
+      const size_t n = l.samples.size();
+      const size_t keep = std::min<size_t>(n, static_cast<size_t>(opt_.max_points));
+      for (size_t k = 0; k < keep; ++k) {  // evenly spread subset
+        const size_t i = k * n / keep;
+        tl.u.push_back(l.samples[i].x);
+        tl.v.push_back(l.samples[i].y);
+        tl.score.push_back(i < l.scores.size() ? l.scores[i] : 0.0f);
+      }
+      tl.npoints = static_cast<int32_t>(tl.u.size());
+      m.levels.push_back(tl);
+    }
+    m.nlevels = static_cast<int32_t>(m.levels.size());
+  }
+  bus_.publish(opt_.track_channel, m);
+  count("tracks_published");
+
+  if (s && !s->lost && opt_.target.width_m > 0 && last_camera_) {
+    try {
+      const TargetPose p = target_pose(*s, *last_camera_, opt_.target);
+      aerie::target_pose_t tp{};
+      tp.utime = m.utime;
+      tp.seq = pose_seq_++;
+      tp.target = opt_.target_name;
+      for (int i = 0; i < 3; ++i) tp.position[i] = p.position[i];
+      tp.yaw = p.yaw;
+      tp.confidence = m.confidence;
+      bus_.publish(opt_.pose_channel, tp);
+      count("poses_published");
+    } catch (const std::exception& e) {
+      count("pose_errors");
+      fail(opt_.pose_channel + ": " + e.what());
+    }
+  }
+  std::lock_guard lk(mutex_);
+  hop_source_ = m.utime;
+  hop_receive_ = frame.receive_utime;
+  hop_publish_ = util::wall_utime();
+}
+
+}  // namespace aerie::track

@@ -1,0 +1,115 @@
+#pragma once
+// The air-side tracking node (aerie-track) as a class: subscribes to a camera channel
+// (aerie.image_t, or aerie.stereo_image_t whose left image is tracked), TRACK_CMD (operator
+// commands) and optionally GT_TRACK (simulator ground truth, to initialise without an
+// operator); publishes TRACK for every processed frame with the source frame's utime and
+// TARGET_POSE when the target's size and the camera intrinsics are known.
+//
+// The LCM thread only stores the newest frame and queues commands; a worker thread decodes
+// and tracks. When the worker falls behind, older frames are replaced by newer ones and
+// counted as skipped: the camera is never blocked.
+#include <aerie/gt_box_t.hpp>
+#include <aerie/image_t.hpp>
+#include <aerie/stereo_image_t.hpp>
+#include <aerie/track_cmd_t.hpp>
+#include <aerie/track_t.hpp>
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "air/track/landing/target_pose.hpp"
+#include "air/track/tracker.hpp"
+#include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
+#include "common/util/config.hpp"
+
+namespace aerie::track {
+
+struct NodeOptions {
+  std::string camera_channel = "CAM_LEFT";
+  bool stereo = false;  // the camera channel carries stereo_image_t (CAM_STEREO); track its left image
+  std::string command_channel = "TRACK_CMD";
+  std::string track_channel = "TRACK";
+  std::string pose_channel = "TARGET_POSE";
+  std::string gt_channel = "GT_TRACK";
+  std::string tracker = "amcmr-ct";  // used by INIT commands that name none
+  uint64_t seed = 1;
+  util::Config trackers;  // per-tracker parameter sections (track.yaml "trackers:")
+  int max_points = 200;   // sample positions per level published for display
+  int init_from_gt = -1;  // >= 0: after this many frames, initialise on the GT_TRACK box
+  std::string target_name = "target";
+  TargetGeometry target;  // width/height 0: no TARGET_POSE
+  std::optional<camera::CameraModel> camera;  // intrinsics (stereo messages bring their own)
+};
+
+// Reads the "node", "target", "camera" and "trackers" sections of track.yaml; throws naming
+// the file and key on a bad value.
+NodeOptions node_options(const util::Config& cfg);
+
+class TrackNode {
+ public:
+  TrackNode(bus::Bus& bus, NodeOptions options);
+  ~TrackNode();
+  TrackNode(const TrackNode&) = delete;
+  TrackNode& operator=(const TrackNode&) = delete;
+
+  // Copies the worker's counters, health and last hop into the status reporter (call from
+  // the thread that owns the reporter).
+  void report(bus::StatusReporter& status);
+  // Blocks until every frame and command received so far is processed (tests); false on timeout.
+  bool wait_idle(int timeout_ms);
+  int64_t counter(const std::string& name) const;
+
+ private:
+  struct Frame {
+    aerie::image_t image;
+    int64_t receive_utime = 0;
+    std::optional<camera::CameraModel> camera;  // from a stereo message
+  };
+  void on_frame(Frame frame);
+  void on_command(const aerie::track_cmd_t& cmd);
+  void on_gt(const aerie::gt_box_t& gt);
+  void run();
+  void execute(const aerie::track_cmd_t& cmd);
+  void process(const Frame& frame);
+  void start_tracker(const std::string& name, const util::Config& params, const cv::Rect2d& box);
+  void publish(const Frame& frame, const TrackState* state, double ms);
+  void count(const std::string& name, int64_t n = 1);
+  void fail(const std::string& message);
+
+  bus::Bus& bus_;
+  NodeOptions opt_;
+
+  // Shared between the LCM thread and the worker.
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::optional<Frame> pending_;
+  std::deque<aerie::track_cmd_t> commands_;
+  std::map<std::string, int64_t> counters_;
+  std::string error_;
+  bool error_fresh_ = false;
+  bool busy_ = false, stop_ = false;
+  int64_t hop_source_ = 0, hop_receive_ = 0, hop_publish_ = 0;
+  std::deque<aerie::gt_box_t> gt_;  // recent ground-truth boxes (init_from_gt)
+
+  // Worker state.
+  std::deque<aerie::track_cmd_t> deferred_;  // INIT commands waiting for the first frame
+  std::unique_ptr<Tracker> tracker_;
+  std::string tracker_name_;
+  util::Config tracker_params_;
+  cv::Mat last_frame_;
+  std::optional<camera::CameraModel> last_camera_;
+  cv::Rect2d last_box_;
+  int64_t frames_seen_ = 0, seq_ = 0, pose_seq_ = 0;
+  bool gt_init_done_ = false;
+  std::thread worker_;
+};
+
+}  // namespace aerie::track

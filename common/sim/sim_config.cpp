@@ -1,0 +1,119 @@
+#include "common/sim/sim_config.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <vector>
+
+namespace aerie::sim {
+
+namespace {
+
+// Reads the keys of one section into a struct, each key named once; finish() then rejects
+// any key of the section that was not read (a typo would otherwise be silently ignored).
+template <typename S>
+class SectionReader {
+ public:
+  SectionReader(const util::Config& section, S& out) : c_(section), out_(out) {}
+  template <typename T>
+  SectionReader& operator()(const std::string& key, T S::*member) {
+    out_.*member = c_.get<T>(key, out_.*member);
+    known_.push_back(key);
+    return *this;
+  }
+  void finish() const {
+    const YAML::Node& n = c_.node();
+    if (!n || n.IsNull()) return;
+    if (!n.IsMap()) throw std::runtime_error(c_.origin() + ": expected a map of keys");
+    for (const auto& kv : n) {
+      const std::string key = kv.first.as<std::string>();
+      if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
+      std::string list;
+      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
+      throw std::runtime_error(c_.origin() + ": unknown key '" + key + "' (known: " + list + ")");
+    }
+  }
+
+ private:
+  const util::Config& c_;
+  S& out_;
+  std::vector<std::string> known_;
+};
+
+}  // namespace
+
+WorldConfig load_world_config(const util::Config& c) {
+  WorldConfig w;
+  using W = WorldConfig;
+  SectionReader<W>(c, w)("seed", &W::seed)("room_x", &W::room_x)("room_y", &W::room_y)("room_z", &W::room_z)(
+      "n_obstacles", &W::n_obstacles)("helipad_size", &W::helipad_size)("helipad_yaw_deg", &W::helipad_yaw_deg)(
+      "texels_per_metre", &W::texels_per_metre)("route_margin", &W::route_margin)(
+      "route_clearance", &W::route_clearance)("cruise_altitude", &W::cruise_altitude)
+      .finish();
+  return w;
+}
+
+RigConfig load_rig_config(const util::Config& c) {
+  RigConfig r;
+  using R = RigConfig;
+  SectionReader<R>(c, r)("width", &R::width)("height", &R::height)("baseline", &R::baseline)(
+      "hfov_deg", &R::hfov_deg)("vfov_deg", &R::vfov_deg)("pitch_deg", &R::pitch_deg)("color", &R::color)(
+      "noise_sigma", &R::noise_sigma)("noise_seed", &R::noise_seed)("exposure", &R::exposure)(
+      "illumination_amplitude", &R::illumination_amplitude)("illumination_period", &R::illumination_period)(
+      "right_gain", &R::right_gain)("motion_blur_samples", &R::motion_blur_samples)(
+      "exposure_time", &R::exposure_time)("disparity", &R::disparity)
+      .finish();
+  return r;
+}
+
+TrajectoryConfig load_trajectory_config(const util::Config& c) {
+  TrajectoryConfig t;
+  using T = TrajectoryConfig;
+  SectionReader<T>(c, t)("kind", &T::kind)("speed", &T::speed)("loops", &T::loops)("rate_hz", &T::rate_hz)(
+      "start_utime", &T::start_utime)
+      .finish();
+  if (t.kind != "demo" && t.kind != "loops" && t.kind != "landing")
+    throw std::runtime_error(c.origin() + ": key 'kind' must be demo, loops or landing (got '" + t.kind + "')");
+  return t;
+}
+
+IntruderConfig load_intruder_config(const util::Config& c) {
+  IntruderConfig i;
+  using I = IntruderConfig;
+  SectionReader<I>(c, i)("seed", &I::seed)("width", &I::width)("height", &I::height)("frames", &I::frames)(
+      "rate_hz", &I::rate_hz)("start_utime", &I::start_utime)("vibration_px", &I::vibration_px)(
+      "wingspan_px", &I::wingspan_px)("scale_change", &I::scale_change)("max_roll_deg", &I::max_roll_deg)(
+      "noise_sigma", &I::noise_sigma)("color", &I::color)
+      .finish();
+  return i;
+}
+
+SimulationConfig load_simulation_config(const util::Config& c) {
+  const YAML::Node& root = c.node();
+  if (root && root.IsMap())
+    for (const auto& kv : root) {
+      const std::string key = kv.first.as<std::string>();
+      if (key != "world" && key != "rig" && key != "trajectory" && key != "intruder")
+        throw std::runtime_error(c.origin() + ": unknown section '" + key +
+                                 "' (known: world, rig, trajectory, intruder)");
+    }
+  SimulationConfig s;
+  s.world = load_world_config(c.section("world"));
+  s.rig = load_rig_config(c.section("rig"));
+  s.trajectory = load_trajectory_config(c.section("trajectory"));
+  return s;
+}
+
+Trajectory make_trajectory(const World& world, const TrajectoryConfig& t) {
+  if (t.kind == "loops") return Trajectory::survey_loops(world, t.loops, t.speed);
+  if (t.kind == "landing") return Trajectory::landing(world, t.speed);
+  return Trajectory::demo_flight(world, t.speed);
+}
+
+StereoSimulation make_simulation(const SimulationConfig& s) {
+  World world = World::room(s.world);
+  Trajectory trajectory = make_trajectory(world, s.trajectory);
+  return StereoSimulation(std::move(world), s.rig, std::move(trajectory), s.trajectory.rate_hz,
+                          s.trajectory.start_utime);
+}
+
+}  // namespace aerie::sim

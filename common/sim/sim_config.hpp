@@ -1,0 +1,38 @@
+#pragma once
+// The simulator's YAML configuration (config/sim/*.yaml): sections `world`, `rig`,
+// `trajectory` and `intruder`, every key optional (defaults are the structs' defaults),
+// unknown keys rejected with the file and key named.
+#include <cstdint>
+#include <string>
+
+#include "common/sim/intruder.hpp"
+#include "common/sim/simulation.hpp"
+#include "common/util/config.hpp"
+
+namespace aerie::sim {
+
+struct TrajectoryConfig {
+  std::string kind = "demo";  // demo | loops | landing
+  double speed = 0.8;         // m/s
+  int loops = 10;             // for kind == loops
+  double rate_hz = 20.0;      // frame rate
+  int64_t start_utime = 0;    // utime of frame 0 (us)
+};
+
+struct SimulationConfig {
+  WorldConfig world;
+  RigConfig rig;
+  TrajectoryConfig trajectory;
+};
+
+WorldConfig load_world_config(const util::Config& section);
+RigConfig load_rig_config(const util::Config& section);
+TrajectoryConfig load_trajectory_config(const util::Config& section);
+IntruderConfig load_intruder_config(const util::Config& section);
+// The `world`, `rig` and `trajectory` sections of a file (or of an empty Config: defaults).
+SimulationConfig load_simulation_config(const util::Config& config);
+
+Trajectory make_trajectory(const World& world, const TrajectoryConfig& config);
+StereoSimulation make_simulation(const SimulationConfig& config);
+
+}  // namespace aerie::sim

@@ -1,0 +1,391 @@
+#include "ground/map/map_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "common/spherical/spherical_message.hpp"
+#include "common/util/time.hpp"
+
+namespace aerie::map {
+
+namespace {
+
+std::optional<geometry::SE3> pose_of(const aerie::pose_t& m) {
+  const Eigen::Vector4d q(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]);
+  const Eigen::Vector3d t(m.position[0], m.position[1], m.position[2]);
+  if (!q.allFinite() || !t.allFinite() || std::abs(q.norm() - 1.0) > 1e-3) return std::nullopt;
+  return geometry::SE3::from_wxyz(m.orientation, m.position);
+}
+
+std::string seconds(int64_t us) {
+  std::ostringstream s;
+  s << static_cast<double>(us) * 1e-6 << " s";
+  return s.str();
+}
+
+void merge(std::optional<Region>& into, const std::optional<Region>& r) {
+  if (!r) return;
+  if (!into) {
+    into = r;
+    return;
+  }
+  into->min = into->min.cwiseMin(r->min);
+  into->max = into->max.cwiseMax(r->max);
+}
+
+}  // namespace
+
+MapServiceConfig MapServiceConfig::from_config(const util::Config& cfg) {
+  MapServiceConfig c;
+  auto& o = c.occupancy;
+  o.resolution = cfg.get("resolution", o.resolution);
+  o.sensor_model.max_range = cfg.get("sensor_model.max_range", o.sensor_model.max_range);
+  o.sensor_model.hit = cfg.get("sensor_model.hit", o.sensor_model.hit);
+  o.sensor_model.miss = cfg.get("sensor_model.miss", o.sensor_model.miss);
+  o.sensor_model.min = cfg.get("sensor_model.min", o.sensor_model.min);
+  o.sensor_model.max = cfg.get("sensor_model.max", o.sensor_model.max);
+  o.pointcloud_min_z = cfg.get("pointcloud_min_z", o.pointcloud_min_z);
+  o.pointcloud_max_z = cfg.get("pointcloud_max_z", o.pointcloud_max_z);
+  o.stereo.focal_px = cfg.get("stereo.focal_px", o.stereo.focal_px);
+  o.stereo.baseline_m = cfg.get("stereo.baseline_m", o.stereo.baseline_m);
+  o.stereo.disparity_sigma_px = cfg.get("stereo.disparity_sigma_px", o.stereo.disparity_sigma_px);
+  o.stereo.free_margin_sigmas = cfg.get("stereo.free_margin_sigmas", o.stereo.free_margin_sigmas);
+  o.stereo.weight_hits = cfg.get("stereo.weight_hits", o.stereo.weight_hits);
+  o.visibility_if_occluded = cfg.get("visibility_if_occluded", o.visibility_if_occluded);
+  try {
+    o.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(cfg.origin() + ": " + e.what());
+  }
+  c.distance_max = cfg.get("distance_map.max_distance", c.distance_max);
+  c.distance_max_cells = static_cast<size_t>(cfg.get<int64_t>("distance_map.max_cells", static_cast<int64_t>(c.distance_max_cells)));
+  c.publish_period_s = cfg.get("publish.period_s", c.publish_period_s);
+  c.full_every = cfg.get("publish.full_every", c.full_every);
+  c.publish_binary = cfg.get("publish.binary", c.publish_binary);
+  c.pose_tolerance_us = cfg.get("matching.pose_tolerance_us", c.pose_tolerance_us);
+  c.pose_wait_us = cfg.get("matching.pose_wait_us", c.pose_wait_us);
+  c.max_future_us = cfg.get("matching.max_future_us", c.max_future_us);
+  c.pose_buffer = static_cast<size_t>(cfg.get<int64_t>("matching.pose_buffer", static_cast<int64_t>(c.pose_buffer)));
+  c.pose_channel = cfg.get("channels.pose", c.pose_channel);
+  c.depth_channel = cfg.get("channels.depth", c.depth_channel);
+  c.octomap_channel = cfg.get("channels.octomap", c.octomap_channel);
+  c.query_channel = cfg.get("channels.query", c.query_channel);
+  c.response_channel = cfg.get("channels.response", c.response_channel);
+  c.cmd_channel = cfg.get("channels.cmd", c.cmd_channel);
+  if (!(c.distance_max > 0)) throw std::runtime_error(cfg.origin() + ": distance_map.max_distance must be > 0");
+  if (c.full_every < 1) throw std::runtime_error(cfg.origin() + ": publish.full_every must be >= 1");
+  if (c.pose_tolerance_us < 0 || c.pose_wait_us < 0 || c.max_future_us <= 0 || c.pose_buffer < 1)
+    throw std::runtime_error(cfg.origin() + ": matching.* must be >= 0 (max_future_us, pose_buffer > 0)");
+  return c;
+}
+
+MapService::MapService(bus::Bus& bus, bus::StatusReporter& status, const MapServiceConfig& config)
+    : bus_(bus),
+      status_(status),
+      config_(config),
+      map_(config.occupancy),
+      distances_(config.distance_max, config.distance_max_cells) {
+  // Depth frames are large and the update can take tens of ms: a deep queue, and a
+  // seq gap count on the subscription tells when LCM still dropped some.
+  bus_.subscribe<aerie::pose_t>(config_.pose_channel, [this](const auto& m, const auto& i) { on_pose(m, i); }, 200);
+  bus_.subscribe<aerie::spherical_depth_t>(config_.depth_channel,
+                                           [this](const auto& m, const auto& i) { on_depth(m, i); }, 100);
+  bus_.subscribe<aerie::map_query_t>(config_.query_channel, [this](const auto& m, const auto& i) { on_query(m, i); },
+                                     100);
+  bus_.subscribe<aerie::map_cmd_t>(config_.cmd_channel, [this](const auto& m, const auto& i) { on_cmd(m, i); });
+}
+
+void MapService::reject(const std::string& counter, const std::string& message) {
+  status_.count(counter);
+  status_.warn(message);
+  spdlog::warn("{}", message);
+}
+
+bool MapService::accept_time(int64_t utime, const char* what) {
+  if (newest_utime_ >= 0 && utime > newest_utime_ + config_.max_future_us) {
+    reject("future_utime", std::string(what) + " utime " + std::to_string(utime) + " is " +
+                               seconds(utime - newest_utime_) + " ahead of the newest message (limit " +
+                               seconds(config_.max_future_us) + "); dropped");
+    return false;
+  }
+  newest_utime_ = std::max(newest_utime_, utime);
+  return true;
+}
+
+std::optional<geometry::SE3> MapService::vo_pose_at(int64_t utime) const {
+  auto it = poses_.lower_bound(utime - config_.pose_tolerance_us);
+  if (it == poses_.end() || it->first > utime + config_.pose_tolerance_us) return std::nullopt;
+  // The closest within the tolerance.
+  auto best = it;
+  for (; it != poses_.end() && it->first <= utime + config_.pose_tolerance_us; ++it)
+    if (std::llabs(it->first - utime) < std::llabs(best->first - utime)) best = it;
+  return best->second;
+}
+
+void MapService::on_pose(const aerie::pose_t& msg, const bus::ReceiveInfo& info) {
+  status_.count("poses");
+  if (msg.status != aerie::pose_t::OK) {
+    status_.count("poses_not_ok");  // initialising, lost or reset: not used for mapping
+    return;
+  }
+  const auto pose = pose_of(msg);
+  if (!pose) {
+    reject("poses_invalid", config_.pose_channel + " seq " + std::to_string(msg.seq) +
+                                ": position/orientation not finite or not a unit quaternion; dropped");
+    return;
+  }
+  if (!accept_time(msg.utime, config_.pose_channel.c_str())) return;
+  poses_[msg.utime] = *pose;
+  while (poses_.size() > config_.pose_buffer) poses_.erase(poses_.begin());
+  // Depth frames that were waiting for this pose.
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    if (std::llabs(it->first - msg.utime) <= config_.pose_tolerance_us) {
+      status_.count("pose_from_vo");
+      const auto [utime, depth] = std::move(*it);
+      it = pending_.erase(it);
+      insert(depth, utime, *pose, info.recv_utime);
+    } else {
+      ++it;
+    }
+  }
+  expire_pending();
+}
+
+void MapService::on_depth(const aerie::spherical_depth_t& msg, const bus::ReceiveInfo& info) {
+  status_.count("depth_frames");
+  std::optional<geometry::SE3> own_pose;
+  spherical::SphericalDepth depth;
+  try {
+    depth = spherical::from_message(msg);
+    own_pose = spherical::pose_of(msg);
+  } catch (const std::invalid_argument& e) {
+    reject("depth_malformed", config_.depth_channel + " seq " + std::to_string(msg.seq) + ": " + e.what() +
+                                  "; dropped");
+    return;
+  }
+  if (!accept_time(msg.utime, config_.depth_channel.c_str())) return;
+  if (msg.utime < last_depth_utime_) status_.count("depth_out_of_order");  // still mapped
+  if (const auto vo = vo_pose_at(msg.utime)) {
+    status_.count("pose_from_vo");
+    insert(depth, msg.utime, *vo, info.recv_utime);
+  } else if (own_pose) {
+    status_.count("pose_from_depth");
+    insert(depth, msg.utime, *own_pose, info.recv_utime);
+  } else {
+    status_.count("depth_waiting_for_pose");
+    pending_.push_back({msg.utime, std::move(depth)});
+  }
+  expire_pending();
+}
+
+void MapService::expire_pending() {
+  while (!pending_.empty() &&
+         (pending_.front().first + config_.pose_wait_us < newest_utime_ || pending_.size() > 100)) {
+    reject("depth_without_pose", config_.depth_channel + " utime " + std::to_string(pending_.front().first) +
+                                     " has no pose and no " + config_.pose_channel + " within " +
+                                     seconds(config_.pose_wait_us) + "; dropped");
+    pending_.pop_front();
+  }
+}
+
+void MapService::insert(const spherical::SphericalDepth& depth, int64_t utime, const geometry::SE3& T_world_camera,
+                        int64_t receive_utime) {
+  util::Stopwatch watch;
+  FrameStats stats;
+  try {
+    stats = map_.insert_depth(depth, T_world_camera);
+  } catch (const std::invalid_argument& e) {
+    reject("depth_rejected", config_.depth_channel + " utime " + std::to_string(utime) + ": " + e.what());
+    return;
+  }
+  status_.time_ms("insert", watch.ms());
+  status_.count("frames_mapped");
+  status_.count("points", static_cast<int64_t>(stats.points));
+  status_.count("points_nonfinite", static_cast<int64_t>(stats.nonfinite));
+  status_.count("points_outside_z", static_cast<int64_t>(stats.outside_z));
+  status_.count("points_beyond_range", static_cast<int64_t>(stats.beyond_range));
+  status_.set("map_nodes", static_cast<int64_t>(map_.tree().size()));
+  status_.set("map_bytes", static_cast<int64_t>(map_.memory_bytes()));
+  merge(unpublished_, map_.take_changed_region());
+  last_depth_utime_ = std::max(last_depth_utime_, utime);
+  status_.ok();
+  maybe_publish(utime);
+  status_.mark_hop(utime, receive_utime, util::wall_utime());
+}
+
+void MapService::maybe_publish(int64_t utime) {
+  if (config_.publish_period_s <= 0) return;
+  const auto period = static_cast<int64_t>(config_.publish_period_s * 1e6);
+  if (last_publish_utime_ >= 0 && utime - last_publish_utime_ < period && utime >= last_publish_utime_) return;
+  last_publish_utime_ = utime;
+  const bool full = publications_ % config_.full_every == 0;
+  if (!full && !unpublished_) return;  // nothing changed
+  util::Stopwatch watch;
+  const auto msg = encode(utime, full ? std::nullopt : unpublished_);
+  status_.time_ms("encode", watch.ms());
+  bus_.publish(config_.octomap_channel, msg);
+  ++publications_;
+  unpublished_.reset();
+  status_.count(full ? "octomap_full" : "octomap_partial");
+  status_.count("octomap_bytes", msg.length);
+}
+
+void MapService::publish_full(int64_t utime) {
+  const auto msg = encode(utime, std::nullopt);
+  bus_.publish(config_.octomap_channel, msg);
+  unpublished_.reset();
+  status_.count("octomap_full");
+  status_.count("octomap_bytes", msg.length);
+}
+
+aerie::octomap_t MapService::encode(int64_t utime, const std::optional<Region>& region) {
+  aerie::octomap_t msg{};
+  msg.utime = utime;
+  msg.seq = publish_seq_++;
+  msg.resolution = map_.params().resolution;
+  msg.binary = config_.publish_binary;
+  msg.full = !region.has_value();
+  MapTree* tree = &map_.tree();
+  std::unique_ptr<MapTree> part;
+  if (region) {
+    // The leaves inside (or overlapping) the region, at their own depth.
+    part = std::make_unique<MapTree>(msg.resolution);
+    const octomap::point3d lo(static_cast<float>(region->min.x()), static_cast<float>(region->min.y()),
+                              static_cast<float>(region->min.z()));
+    const octomap::point3d hi(static_cast<float>(region->max.x()), static_cast<float>(region->max.y()),
+                              static_cast<float>(region->max.z()));
+    for (auto it = tree->begin_leafs_bbx(lo, hi), end = tree->end_leafs_bbx(); it != end; ++it)
+      part->set_node(it.getKey(), it.getDepth(), it->getLogOdds());
+    part->updateInnerOccupancy();
+    tree = part.get();
+    for (int i = 0; i < 3; ++i) {
+      msg.bbox_min[i] = region->min[i];
+      msg.bbox_max[i] = region->max[i];
+    }
+  } else {
+    double x0 = 0, y0 = 0, z0 = 0, x1 = 0, y1 = 0, z1 = 0;
+    if (tree->size() > 0) {
+      tree->getMetricMin(x0, y0, z0);
+      tree->getMetricMax(x1, y1, z1);
+    }
+    msg.bbox_min[0] = x0, msg.bbox_min[1] = y0, msg.bbox_min[2] = z0;
+    msg.bbox_max[0] = x1, msg.bbox_max[1] = y1, msg.bbox_max[2] = z1;
+  }
+  std::ostringstream out;
+  if (msg.binary)
+    tree->writeBinaryConst(out);
+  else
+    tree->write(out);
+  const std::string bytes = out.str();
+  msg.data.assign(bytes.begin(), bytes.end());
+  msg.length = static_cast<int32_t>(msg.data.size());
+  return msg;
+}
+
+aerie::map_response_t MapService::answer(const aerie::map_query_t& q) {
+  aerie::map_response_t r{};
+  r.utime = q.utime;
+  r.seq = q.seq;
+  r.kind = q.kind;
+  r.distance = -1.0;
+  r.probability = 0.5;
+  const Eigen::Vector3d p(q.point[0], q.point[1], q.point[2]);
+  if (!p.allFinite()) throw std::invalid_argument("point is not finite");
+  if (q.depth < 0 || q.depth > 16) throw std::invalid_argument("depth must be 0..16, got " + std::to_string(q.depth));
+  const auto depth = static_cast<unsigned>(q.depth);
+  switch (q.kind) {
+    case aerie::map_query_t::OCCUPANCY: {
+      const auto v = map_.occupancy(p, depth);
+      r.occupancy = static_cast<int8_t>(v.state);
+      r.probability = v.probability;
+      r.voxel_size = v.voxel_size;
+      for (int i = 0; i < 3; ++i) r.hit[i] = v.center[i];
+      break;
+    }
+    case aerie::map_query_t::NEAREST_OBSTACLE: {
+      distances_.update(map_);
+      const auto n = distances_.nearest(p);
+      r.voxel_size = map_.params().resolution;
+      if (n.distance >= 0 && (q.max_range <= 0 || n.distance <= q.max_range)) {
+        r.distance = n.distance;
+        r.occupancy = aerie::map_response_t::OCCUPIED;
+        for (int i = 0; i < 3; ++i) r.hit[i] = n.obstacle[i];
+      }
+      break;
+    }
+    case aerie::map_query_t::RAY: {
+      const auto ray = map_.cast_ray(p, {q.direction[0], q.direction[1], q.direction[2]}, q.max_range, depth);
+      r.voxel_size = map_.occupancy(p, depth).voxel_size;
+      if (ray.hit) {
+        r.occupancy = aerie::map_response_t::OCCUPIED;
+        r.distance = ray.distance;
+        for (int i = 0; i < 3; ++i) r.hit[i] = ray.hit_center[i];
+      } else {
+        r.occupancy = ray.crossed_unknown ? aerie::map_response_t::UNKNOWN : aerie::map_response_t::FREE;
+      }
+      break;
+    }
+    default:
+      throw std::invalid_argument("unknown query kind " + std::to_string(q.kind));
+  }
+  return r;
+}
+
+void MapService::on_query(const aerie::map_query_t& q, const bus::ReceiveInfo&) {
+  status_.count("queries");
+  aerie::map_response_t r;
+  try {
+    r = answer(q);
+  } catch (const std::exception& e) {
+    r = aerie::map_response_t{};
+    r.utime = q.utime;
+    r.seq = q.seq;
+    r.kind = q.kind;
+    r.distance = -1.0;
+    r.error = std::string("map query seq ") + std::to_string(q.seq) + ": " + e.what();
+    reject("query_errors", r.error);
+  }
+  bus_.publish(q.reply_channel.empty() ? config_.response_channel : q.reply_channel, r);
+}
+
+void MapService::load(const std::string& path) {
+  map_.load(path);
+  unpublished_.reset();
+  publications_ = 0;  // the next publication is the full map
+  spdlog::info("loaded map '{}' ({} nodes, resolution {} m)", path, map_.tree().size(), map_.params().resolution);
+}
+
+void MapService::on_cmd(const aerie::map_cmd_t& c, const bus::ReceiveInfo&) {
+  status_.count("commands");
+  try {
+    switch (c.command) {
+      case aerie::map_cmd_t::SAVE:
+        if (c.path.empty()) throw std::invalid_argument("SAVE needs a path (.bt or .ot)");
+        map_.save(c.path);
+        spdlog::info("saved map to '{}'", c.path);
+        break;
+      case aerie::map_cmd_t::LOAD:
+        if (c.path.empty()) throw std::invalid_argument("LOAD needs a path (.bt or .ot)");
+        load(c.path);
+        break;
+      case aerie::map_cmd_t::CLEAR:
+        map_.clear();
+        unpublished_.reset();
+        publications_ = 0;
+        spdlog::info("map cleared");
+        break;
+      case aerie::map_cmd_t::PUBLISH_FULL:
+        publish_full(newest_utime_ >= 0 ? newest_utime_ : c.utime);
+        break;
+      default:
+        throw std::invalid_argument("unknown command " + std::to_string(c.command));
+    }
+    status_.count("commands_done");
+  } catch (const std::exception& e) {
+    reject("command_errors", config_.cmd_channel + " seq " + std::to_string(c.seq) + ": " + e.what());
+  }
+}
+
+}  // namespace aerie::map

@@ -1,0 +1,94 @@
+#pragma once
+// The LCM side of aerie-map: VO_POSE + VO_DEPTH in, the occupancy map updated, MAP_OCTOMAP
+// out (rate-limited in message time, full or changed region), MAP_QUERY answered,
+// MAP_CMD obeyed. Bad messages are counted in the status and dropped, never fatal.
+#include <aerie/map_cmd_t.hpp>
+#include <aerie/map_query_t.hpp>
+#include <aerie/map_response_t.hpp>
+#include <aerie/octomap_t.hpp>
+#include <aerie/pose_t.hpp>
+#include <aerie/spherical_depth_t.hpp>
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
+#include "common/util/config.hpp"
+#include "ground/map/distance_map.hpp"
+#include "ground/map/occupancy.hpp"
+
+namespace aerie::map {
+
+struct MapServiceConfig {
+  OccupancyParams occupancy;
+  double distance_max = 2.0;                 // distance_map.max_distance (m)
+  size_t distance_max_cells = size_t{64} << 20;  // distance_map.max_cells
+  double publish_period_s = 1.0;             // publish.period_s, in message time; <= 0: never
+  int full_every = 10;                       // publish.full_every: every Nth publication is the full map
+  bool publish_binary = true;                // publish.binary: .bt stream (else .ot with probabilities)
+  int64_t pose_tolerance_us = 1000;          // matching.pose_tolerance_us: |utime difference| to match
+  int64_t pose_wait_us = 500000;             // matching.pose_wait_us: a depth without pose waits this long
+  int64_t max_future_us = 10000000;          // matching.max_future_us: newer than the newest by more: rejected
+  size_t pose_buffer = 400;                  // matching.pose_buffer: VO_POSE messages kept for matching
+  std::string pose_channel = "VO_POSE";      // channels.*
+  std::string depth_channel = "VO_DEPTH";
+  std::string octomap_channel = "MAP_OCTOMAP";
+  std::string query_channel = "MAP_QUERY";
+  std::string response_channel = "MAP_RESPONSE";
+  std::string cmd_channel = "MAP_CMD";
+
+  // Reads config/map.yaml keys (see the file); missing keys keep their defaults.
+  static MapServiceConfig from_config(const util::Config& cfg);
+};
+
+class MapService {
+ public:
+  MapService(bus::Bus& bus, bus::StatusReporter& status, const MapServiceConfig& config);
+
+  OccupancyMap& map() { return map_; }
+  const MapServiceConfig& config() const { return config_; }
+  // Publishes the whole map now (MAP_CMD PUBLISH_FULL does this too).
+  void publish_full(int64_t utime);
+  // Saves the map (.bt or .ot); throws std::runtime_error.
+  void save(const std::string& path) const { map_.save(path); }
+  void load(const std::string& path);
+
+  // Encodes the map, or the part inside `region`, as an octomap_t.
+  aerie::octomap_t encode(int64_t utime, const std::optional<Region>& region);
+
+ private:
+  void on_pose(const aerie::pose_t& msg, const bus::ReceiveInfo& info);
+  void on_depth(const aerie::spherical_depth_t& msg, const bus::ReceiveInfo& info);
+  void on_query(const aerie::map_query_t& msg, const bus::ReceiveInfo& info);
+  void on_cmd(const aerie::map_cmd_t& msg, const bus::ReceiveInfo& info);
+
+  // False (and counted) when utime is too far ahead of the newest message seen.
+  bool accept_time(int64_t utime, const char* what);
+  std::optional<geometry::SE3> vo_pose_at(int64_t utime) const;
+  void insert(const spherical::SphericalDepth& depth, int64_t utime, const geometry::SE3& T_world_camera,
+              int64_t receive_utime);
+  void expire_pending();
+  void maybe_publish(int64_t utime);
+  aerie::map_response_t answer(const aerie::map_query_t& q);
+  void reject(const std::string& counter, const std::string& message);
+
+  bus::Bus& bus_;
+  bus::StatusReporter& status_;
+  MapServiceConfig config_;
+  OccupancyMap map_;
+  DistanceMap distances_;
+  std::map<int64_t, geometry::SE3> poses_;         // VO_POSE by utime
+  std::deque<std::pair<int64_t, spherical::SphericalDepth>> pending_;  // (utime, depth) waiting for VO_POSE
+  int64_t newest_utime_ = -1;                      // newest accepted message time
+  int64_t last_depth_utime_ = -1;
+  int64_t last_publish_utime_ = -1;
+  std::optional<Region> unpublished_;              // changed since the last publication
+  int64_t publish_seq_ = 0;
+  int publications_ = 0;
+};
+
+}  // namespace aerie::map

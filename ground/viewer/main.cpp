@@ -1,0 +1,111 @@
+// aerie-viewer: the ground operator's dashboard (see docs/viewer.md).
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include "common/bus/node.hpp"
+#include "common/util/cli.hpp"
+#include "common/util/time.hpp"
+#include "ground/viewer/viewer.hpp"
+
+namespace {
+std::atomic<bool> g_snapshot_requested{false};
+extern "C" void on_usr1(int) { g_snapshot_requested = true; }
+
+double cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"aerie-viewer: VTK ground dashboard — camera pane with tracker overlay, 3D scene (poses, "
+               "trajectories, depth, OctoMap), charts and process panel. Drag a box on the camera pane to track it."};
+  aerie::util::CommonOptions common;
+  aerie::viewer::ViewerOptions opts;
+  std::string snapshot, record_dir;
+  double after = -1, fps = 20, duration = -1;
+  std::vector<std::string> disable;
+  aerie::util::add_common_options(app, common, false);
+  app.add_option("--image-channel", opts.image_channel, "camera channel for the image pane (image_t, or CAM_STEREO)")
+      ->capture_default_str();
+  app.add_option("--size", opts.width, "window width in pixels")->capture_default_str();
+  app.add_option("--height", opts.height, "window height in pixels")->capture_default_str();
+  app.add_flag("--offscreen", opts.offscreen, "render off-screen (no window); implied by --snapshot/--record");
+  app.add_option("--snapshot", snapshot,
+                 "write a PNG of the whole window: after --after seconds, on SIGUSR1, and at exit");
+  app.add_option("--after", after, "with --snapshot: seconds after start to write it, then exit");
+  app.add_option("--record", record_dir, "write one PNG of the window per second into this folder");
+  app.add_option("--fps", fps, "display frames per second")->capture_default_str()->check(CLI::Range(1.0, 200.0));
+  app.add_option("--duration", duration, "exit after this many seconds (headless runs)");
+  app.add_option("--disable", disable, "renderers to start disabled (by name, e.g. octomap chart-latency)");
+  CLI11_PARSE(app, argc, argv);
+  aerie::util::init_logging("viewer", common.log_level);
+
+  const bool headless = opts.offscreen || !snapshot.empty() || !record_dir.empty();
+  opts.offscreen = headless;
+  if (!headless && !std::getenv("DISPLAY")) {
+    spdlog::error("no DISPLAY: run under X (or xvfb-run -a), or use --offscreen/--snapshot/--record");
+    return 2;
+  }
+  if (!record_dir.empty()) std::filesystem::create_directories(record_dir);
+  try {
+    aerie::bus::Bus bus(common.lcm_url);
+    aerie::viewer::Viewer viewer(bus, opts);
+    viewer.add_default_renderers();
+    for (const auto& name : disable) {
+      auto* r = viewer.find(name);
+      if (!r) {
+        spdlog::error("--disable: no renderer named '{}'", name);
+        return 2;
+      }
+      r->set_enabled(false);
+    }
+    aerie::bus::install_stop_handlers();
+    std::signal(SIGUSR1, on_usr1);
+    viewer.start();
+    const double t0 = aerie::util::mono_ms() / 1000.0, cpu0 = cpu_seconds();
+    if (!headless) {
+      viewer.run_interactive(fps);
+    } else {
+      double next_record = t0;
+      int record_index = 0;
+      const auto period = std::chrono::duration<double>(1.0 / fps);
+      while (!aerie::bus::stop_requested()) {
+        const auto frame_start = std::chrono::steady_clock::now();
+        viewer.render_frame();
+        const double now = aerie::util::mono_ms() / 1000.0;
+        if (g_snapshot_requested.exchange(false) && !snapshot.empty()) viewer.snapshot(snapshot);
+        if (!record_dir.empty() && now >= next_record) {
+          char name[64];
+          std::snprintf(name, sizeof(name), "frame-%06d.png", record_index++);
+          viewer.snapshot((std::filesystem::path(record_dir) / name).string());
+          next_record += 1.0;
+        }
+        if (after >= 0 && now - t0 >= after) break;
+        if (duration >= 0 && now - t0 >= duration) break;
+        std::this_thread::sleep_until(frame_start + period);
+      }
+    }
+    const double wall = aerie::util::mono_ms() / 1000.0 - t0, cpu = cpu_seconds() - cpu0;
+    viewer.stop();
+    if (!snapshot.empty()) {
+      viewer.snapshot(snapshot);
+      spdlog::info("snapshot written to {}", snapshot);
+    }
+    spdlog::info("displayed {} frames in {:.1f} s: {:.1f} frames/s, CPU {:.0f}% of one core",
+                 viewer.frames_rendered(), wall, viewer.frames_rendered() / std::max(wall, 1e-9),
+                 100.0 * cpu / std::max(wall, 1e-9));
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  return 0;
+}

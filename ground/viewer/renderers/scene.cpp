@@ -1,0 +1,405 @@
+#include "ground/viewer/renderers/scene.hpp"
+
+#include <octomap/OcTree.h>
+#include <spdlog/spdlog.h>
+#include <vtkAxesActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCubeSource.h>
+#include <vtkFloatArray.h>
+#include <vtkGlyph3DMapper.h>
+#include <vtkLookupTable.h>
+#include <vtkCellData.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+
+#include <mutex>
+#include <sstream>
+
+#include "common/spherical/spherical_message.hpp"
+#include "ground/viewer/layout.hpp"
+
+namespace aerie::viewer {
+namespace {
+
+vtkSmartPointer<vtkActor> line_actor(double r, double g, double b, double width) {
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(vtkSmartPointer<vtkPolyData>::New());
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(r, g, b);
+  actor->GetProperty()->SetLineWidth(static_cast<float>(width));
+  actor->GetProperty()->LightingOff();
+  return actor;
+}
+
+vtkPolyData* poly_of(vtkActor* a) { return vtkPolyData::SafeDownCast(a->GetMapper()->GetInput()); }
+
+// Camera frustum (apex at the optical centre, 0.3 m deep, 98 x 73 degree FOV) in the world.
+void set_frustum(vtkPolyData* poly, const geometry::SE3& T) {
+  const double d = 0.3, hx = d * std::tan(49.0 * M_PI / 180), hy = d * std::tan(36.5 * M_PI / 180);
+  const Eigen::Vector3d c[5] = {{0, 0, 0}, {-hx, -hy, d}, {hx, -hy, d}, {hx, hy, d}, {-hx, hy, d}};
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  for (const auto& p : c) {
+    const Eigen::Vector3d w = T * p;
+    pts->InsertNextPoint(w.x(), w.y(), w.z());
+  }
+  auto lines = vtkSmartPointer<vtkCellArray>::New();
+  const vtkIdType edges[8][2] = {{0, 1}, {0, 2}, {0, 3}, {0, 4}, {1, 2}, {2, 3}, {3, 4}, {4, 1}};
+  for (const auto& e : edges) lines->InsertNextCell(2, e);
+  poly->SetPoints(pts);
+  poly->SetLines(lines);
+  poly->Modified();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- grid
+GridRenderer::GridRenderer(double half_size_m, double spacing_m)
+    : Renderer("grid"), half_(half_size_m), spacing_(spacing_m) {}
+
+void GridRenderer::attach(Layout& layout) {
+  grid_ = line_actor(0.45, 0.45, 0.5, 1);
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  auto lines = vtkSmartPointer<vtkCellArray>::New();
+  for (double s = -half_; s <= half_ + 1e-9; s += spacing_) {
+    const vtkIdType a = pts->InsertNextPoint(s, -half_, 0), b = pts->InsertNextPoint(s, half_, 0);
+    const vtkIdType c = pts->InsertNextPoint(-half_, s, 0), d = pts->InsertNextPoint(half_, s, 0);
+    const vtkIdType l1[2] = {a, b}, l2[2] = {c, d};
+    lines->InsertNextCell(2, l1);
+    lines->InsertNextCell(2, l2);
+  }
+  poly_of(grid_)->SetPoints(pts);
+  poly_of(grid_)->SetLines(lines);
+  auto axes = vtkSmartPointer<vtkAxesActor>::New();
+  axes->SetTotalLength(1, 1, 1);
+  axes->AxisLabelsOff();
+  axes_ = axes;
+  layout.scene->AddActor(grid_);
+  layout.scene->AddActor(axes_);
+  // An oblique view from behind-left and above; world z is up.
+  vtkCamera* cam = layout.scene->GetActiveCamera();
+  cam->SetFocalPoint(0, 0, 0);
+  cam->SetPosition(-0.9 * half_, -1.3 * half_, 0.9 * half_);
+  cam->SetViewUp(0, 0, 1);
+  layout.scene->ResetCamera();
+}
+
+void GridRenderer::on_enabled(bool on) {
+  if (grid_) grid_->SetVisibility(on);
+  if (axes_) axes_->SetVisibility(on);
+}
+
+// ---------------------------------------------------------------- poses
+PoseRenderer::PoseRenderer(std::string name, std::string channel, bool ground_truth)
+    : Renderer(std::move(name)), channel_(std::move(channel)), gt_(ground_truth) {}
+
+void PoseRenderer::subscribe(bus::Bus& bus) {
+  if (gt_) {
+    bus.subscribe<aerie::gt_pose_t>(channel_, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
+      poses_.push({m.utime, geometry::SE3::from_wxyz(m.orientation, m.position)});
+    });
+  } else {
+    bus.subscribe<aerie::pose_t>(channel_, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
+      if (m.status == aerie::pose_t::RESET) poses_.clear();
+      poses_.push({m.utime, geometry::SE3::from_wxyz(m.orientation, m.position)});
+    });
+  }
+}
+
+void PoseRenderer::attach(Layout& layout) {
+  // Ground truth in green, the estimate in orange.
+  const double r = gt_ ? 0.2 : 1.0, g = gt_ ? 0.9 : 0.55, b = gt_ ? 0.3 : 0.1;
+  path_ = line_actor(r, g, b, 2);
+  frustum_ = line_actor(r, g, b, 2);
+  scene_ = layout.scene;
+  scene_->AddActor(path_);
+  scene_->AddActor(frustum_);
+}
+
+bool PoseRenderer::update() {
+  if (!poses_.snapshot_if_newer(seen_, buffer_)) return false;
+  auto pts = vtkSmartPointer<vtkPoints>::New();
+  auto line = vtkSmartPointer<vtkCellArray>::New();
+  line->InsertNextCell(static_cast<vtkIdType>(buffer_.size()));
+  for (const auto& p : buffer_) {
+    const auto& t = p.T_world_camera.translation();
+    line->InsertCellPoint(pts->InsertNextPoint(t.x(), t.y(), t.z()));
+  }
+  poly_of(path_)->SetPoints(pts);
+  poly_of(path_)->SetLines(line);
+  poly_of(path_)->Modified();
+  if (!buffer_.empty()) set_frustum(poly_of(frustum_), buffer_.back().T_world_camera);
+  shown_ = buffer_.size();
+  if (!camera_fitted_ && shown_ > 1) {
+    scene_->ResetCamera();
+    camera_fitted_ = true;
+  }
+  return true;
+}
+
+int64_t PoseRenderer::latest_utime() const { return 0; }
+
+void PoseRenderer::on_enabled(bool on) {
+  if (path_) path_->SetVisibility(on);
+  if (frustum_) frustum_->SetVisibility(on);
+}
+
+// ---------------------------------------------------------------- depth cloud
+DepthCloudRenderer::DepthCloudRenderer(std::string channel) : Renderer("depth"), channel_(std::move(channel)) {}
+
+void DepthCloudRenderer::subscribe(bus::Bus& bus) {
+  bus.subscribe<aerie::spherical_depth_t>(
+      channel_,
+      [this](const aerie::spherical_depth_t& m, const bus::ReceiveInfo&) {
+        const auto depth = spherical::from_message(m);
+        const auto pose = spherical::pose_of(m);
+        if (!pose) throw std::invalid_argument("VO_DEPTH frame without a pose cannot be placed in the world");
+        std::vector<Eigen::Vector3f> pts = depth.decode();
+        const Eigen::Matrix3f R = pose->rotation_matrix().cast<float>();
+        const Eigen::Vector3f t = pose->translation().cast<float>();
+        for (auto& p : pts) p = R * p + t;
+        cloud_.set(std::move(pts));
+      },
+      2);
+}
+
+void DepthCloudRenderer::attach(Layout& layout) {
+  actor_ = line_actor(0.3, 0.9, 1.0, 1);
+  actor_->GetProperty()->SetPointSize(2);
+  layout.scene->AddActor(actor_);
+}
+
+bool DepthCloudRenderer::update() {
+  std::vector<Eigen::Vector3f> pts;
+  if (!cloud_.take_if_newer(seen_, pts)) return false;
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToFloat();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(pts.size()));
+  auto verts = vtkSmartPointer<vtkCellArray>::New();
+  for (size_t i = 0; i < pts.size(); ++i) {
+    points->SetPoint(static_cast<vtkIdType>(i), pts[i].x(), pts[i].y(), pts[i].z());
+    const vtkIdType id = static_cast<vtkIdType>(i);
+    verts->InsertNextCell(1, &id);
+  }
+  poly_of(actor_)->SetPoints(points);
+  poly_of(actor_)->SetVerts(verts);
+  poly_of(actor_)->Modified();
+  shown_ = pts.size();
+  return true;
+}
+
+void DepthCloudRenderer::on_enabled(bool on) {
+  if (actor_) actor_->SetVisibility(on);
+}
+
+// ---------------------------------------------------------------- octomap
+struct OctomapRenderer::Map {
+  std::mutex m;
+  std::unique_ptr<octomap::OcTree> tree;
+  uint64_t version = 0;
+};
+
+OctomapRenderer::OctomapRenderer(std::string channel)
+    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()) {}
+OctomapRenderer::~OctomapRenderer() = default;
+
+namespace {
+std::unique_ptr<octomap::OcTree> parse_octree(const aerie::octomap_t& m) {
+  if (m.length != static_cast<int32_t>(m.data.size()))
+    throw std::invalid_argument("octomap_t: length disagrees with the payload size");
+  if (!(m.resolution > 0)) throw std::invalid_argument("octomap_t: resolution must be positive");
+  std::istringstream in(std::string(m.data.begin(), m.data.end()));
+  if (m.binary) {
+    auto tree = std::make_unique<octomap::OcTree>(m.resolution);
+    if (!tree->readBinary(in)) throw std::invalid_argument("octomap_t: payload is not an OctoMap binary tree");
+    return tree;
+  }
+  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
+  auto* tree = dynamic_cast<octomap::OcTree*>(any.get());
+  if (!tree) throw std::invalid_argument("octomap_t: payload is not an OctoMap OcTree");
+  any.release();
+  return std::unique_ptr<octomap::OcTree>(tree);
+}
+}  // namespace
+
+void OctomapRenderer::subscribe(bus::Bus& bus) {
+  bus.subscribe<aerie::octomap_t>(
+      channel_,
+      [this](const aerie::octomap_t& m, const bus::ReceiveInfo&) {
+        auto incoming = parse_octree(m);  // parse outside the lock
+        std::lock_guard lock(map_->m);
+        if (m.full || !map_->tree || map_->tree->getResolution() != incoming->getResolution()) {
+          map_->tree = std::move(incoming);
+        } else {
+          // A changed region: replace what the local copy holds inside the box.
+          const octomap::point3d lo(m.bbox_min[0], m.bbox_min[1], m.bbox_min[2]);
+          const octomap::point3d hi(m.bbox_max[0], m.bbox_max[1], m.bbox_max[2]);
+          std::vector<octomap::OcTreeKey> stale;
+          for (auto it = map_->tree->begin_leafs_bbx(lo, hi); it != map_->tree->end_leafs_bbx(); ++it)
+            stale.push_back(it.getKey());
+          for (const auto& k : stale) map_->tree->deleteNode(k);
+          for (auto it = incoming->begin_leafs(); it != incoming->end_leafs(); ++it)
+            map_->tree->setNodeValue(it.getCoordinate(), it->getLogOdds(), true);
+        }
+        ++map_->version;
+      },
+      4);
+}
+
+void OctomapRenderer::attach(Layout& layout) {
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(vtkSmartPointer<vtkPolyData>::New());
+  mapper->SetScalarModeToUseCellData();
+  mapper->ScalarVisibilityOn();
+  auto lut = vtkSmartPointer<vtkLookupTable>::New();
+  lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
+  lut->Build();
+  mapper->SetLookupTable(lut);
+  actor_ = vtkSmartPointer<vtkActor>::New();
+  actor_->SetMapper(mapper);
+  layout.scene->AddActor(actor_);
+}
+
+void OctomapRenderer::set_coarsening(int levels) {
+  coarsening_ = std::clamp(levels, 0, 4);
+  dirty_ = true;
+}
+
+bool OctomapRenderer::on_key(const std::string& key) {
+  if (key != "v") return false;
+  set_coarsening((coarsening_ + 1) % 4);
+  return true;
+}
+
+bool OctomapRenderer::update() {
+  {
+    std::lock_guard lock(map_->m);
+    if (map_->version == seen_ && !dirty_) return false;
+    seen_ = map_->version;
+  }
+  dirty_ = false;
+  extract();
+  return true;
+}
+
+// Occupied voxels as one mesh of their visible faces: a face shared with another
+// occupied voxel is never seen and is left out, which keeps a 100k-voxel map to a few
+// hundred thousand triangles that software OpenGL draws at display rate.
+void OctomapRenderer::extract() {
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToFloat();
+  auto quads = vtkSmartPointer<vtkCellArray>::New();
+  auto height = vtkSmartPointer<vtkFloatArray>::New();
+  height->SetName("height");
+  double zmin = 0, zmax = 1;
+  size_t voxels = 0;
+  {
+    std::lock_guard lock(map_->m);
+    if (!map_->tree) return;
+    auto& tree = *map_->tree;
+    const unsigned depth = tree.getTreeDepth() - static_cast<unsigned>(coarsening_);
+    double lo[3], hi[3];
+    tree.getMetricMin(lo[0], lo[1], lo[2]);
+    tree.getMetricMax(hi[0], hi[1], hi[2]);
+    zmin = lo[2];
+    zmax = std::max(hi[2], zmin + 1e-3);
+    static const int dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (auto it = tree.begin_leafs(depth); it != tree.end_leafs(); ++it) {
+      if (!tree.isNodeOccupied(*it)) continue;
+      ++voxels;
+      const auto c = it.getCoordinate();
+      const float h = static_cast<float>(it.getSize() / 2);
+      for (const auto& d : dirs) {
+        const octomap::point3d n(c.x() + d[0] * (h + 1e-3f), c.y() + d[1] * (h + 1e-3f), c.z() + d[2] * (h + 1e-3f));
+        const auto* nb = tree.search(n, depth);
+        if (nb && tree.isNodeOccupied(nb)) continue;  // hidden face
+        // The face's four corners: the two axes orthogonal to d span it.
+        const int a = d[0] ? 1 : 0, b = d[2] ? 1 : 2;
+        vtkIdType ids[4];
+        const float s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int k = 0; k < 4; ++k) {
+          float p[3] = {c.x(), c.y(), c.z()};
+          for (int axis = 0; axis < 3; ++axis) p[axis] += d[axis] * h;
+          p[a] += s[k][0] * h;
+          p[b] += s[k][1] * h;
+          ids[k] = points->InsertNextPoint(p);
+        }
+        quads->InsertNextCell(4, ids);
+        height->InsertNextValue(c.z());
+      }
+    }
+  }
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  poly->SetPoints(points);
+  poly->SetPolys(quads);
+  poly->GetCellData()->SetScalars(height);
+  auto* mapper = vtkPolyDataMapper::SafeDownCast(actor_->GetMapper());
+  mapper->SetInputData(poly);
+  mapper->SetScalarRange(zmin, zmax);
+  shown_ = voxels;
+}
+
+void OctomapRenderer::on_enabled(bool on) {
+  if (actor_) actor_->SetVisibility(on);
+}
+
+// ---------------------------------------------------------------- target
+TargetPoseRenderer::TargetPoseRenderer(std::string channel, std::string pose_channel, std::string gt_pose_channel)
+    : Renderer("target"),
+      channel_(std::move(channel)),
+      pose_channel_(std::move(pose_channel)),
+      gt_pose_channel_(std::move(gt_pose_channel)) {}
+
+void TargetPoseRenderer::subscribe(bus::Bus& bus) {
+  bus.subscribe<aerie::target_pose_t>(channel_,
+                                      [this](const aerie::target_pose_t& m, const bus::ReceiveInfo&) { target_.set(m); });
+  bus.subscribe<aerie::pose_t>(pose_channel_, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
+    camera_.set(geometry::SE3::from_wxyz(m.orientation, m.position));
+  });
+  bus.subscribe<aerie::gt_pose_t>(gt_pose_channel_, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
+    camera_.set(geometry::SE3::from_wxyz(m.orientation, m.position));
+  });
+}
+
+void TargetPoseRenderer::attach(Layout& layout) {
+  auto sphere = vtkSmartPointer<vtkSphereSource>::New();
+  sphere->SetRadius(0.15);
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputConnection(sphere->GetOutputPort());
+  actor_ = vtkSmartPointer<vtkActor>::New();
+  actor_->SetMapper(mapper);
+  actor_->GetProperty()->SetColor(1, 0.1, 0.1);
+  actor_->VisibilityOff();
+  layout.scene->AddActor(actor_);
+}
+
+bool TargetPoseRenderer::update() {
+  aerie::target_pose_t t;
+  geometry::SE3 c;
+  bool changed = false;
+  if (target_.take_if_newer(seen_target_, t)) {
+    current_ = t;
+    changed = true;
+  }
+  if (camera_.take_if_newer(seen_camera_, c)) {
+    current_camera_ = c;
+    changed = true;
+  }
+  if (!changed || !current_ || !current_camera_) return false;
+  const Eigen::Vector3d w = *current_camera_ * Eigen::Vector3d(current_->position[0], current_->position[1], current_->position[2]);
+  actor_->SetPosition(w.x(), w.y(), w.z());
+  actor_->SetVisibility(enabled());
+  return true;
+}
+
+void TargetPoseRenderer::on_enabled(bool on) {
+  if (actor_) actor_->SetVisibility(on && current_.has_value());
+}
+
+}  // namespace aerie::viewer

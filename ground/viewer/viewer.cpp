@@ -1,0 +1,302 @@
+#include "ground/viewer/viewer.hpp"
+
+#include <spdlog/spdlog.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCommand.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkObjectFactory.h>
+#include <vtkPNGWriter.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "common/bus/node.hpp"
+#include "ground/viewer/renderers/charts.hpp"
+#include "ground/viewer/renderers/panel.hpp"
+#include "ground/viewer/renderers/scene.hpp"
+
+namespace aerie::viewer {
+
+struct Viewer::Help {
+  vtkSmartPointer<vtkTextActor> text = vtkSmartPointer<vtkTextActor>::New();
+};
+
+Viewer::Viewer(bus::Bus& bus, ViewerOptions options)
+    : bus_(bus), options_(std::move(options)), help_(std::make_unique<Help>()) {
+  if (options_.trackers.empty()) throw std::invalid_argument("viewer: the tracker menu is empty");
+  layout_ = Layout::create(options_.width, options_.height, options_.offscreen);
+  image_pane_ = std::make_unique<ImagePane>(layout_.image);
+  help_->text->GetTextProperty()->SetFontSize(13);
+  help_->text->GetTextProperty()->SetColor(1, 1, 0.6);
+  help_->text->SetPosition(6, 6);
+  layout_.image->AddActor2D(help_->text);
+  update_help_text();
+}
+
+Viewer::~Viewer() { stop(); }
+
+Renderer& Viewer::add(std::unique_ptr<Renderer> renderer) {
+  if (auto* cam = dynamic_cast<CameraRenderer*>(renderer.get())) camera_ = cam;
+  renderer->attach(layout_);
+  renderers_.push_back(std::move(renderer));
+  update_help_text();
+  return *renderers_.back();
+}
+
+void Viewer::add_default_renderers() {
+  add(std::make_unique<CameraRenderer>(options_.image_channel));
+  add(std::make_unique<TrackOverlay>());
+  add(std::make_unique<GtBoxOverlay>());
+  add(std::make_unique<GridRenderer>());
+  add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false));
+  add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true));
+  add(std::make_unique<DepthCloudRenderer>());
+  add(std::make_unique<OctomapRenderer>());
+  add(std::make_unique<TargetPoseRenderer>());
+  add_default_charts(*this);
+  add(std::make_unique<ProcmanPanel>());
+}
+
+Renderer* Viewer::find(const std::string& name) const {
+  for (const auto& r : renderers_)
+    if (r->name() == name) return r.get();
+  return nullptr;
+}
+
+void Viewer::start() {
+  if (running_) return;
+  for (auto& r : renderers_) r->subscribe(bus_);
+  running_ = true;
+  lcm_thread_ = std::thread([this] {
+    while (running_ && !bus::stop_requested()) {
+      try {
+        bus_.handle(50);
+      } catch (const std::exception& e) {
+        spdlog::error("LCM handling: {}", e.what());
+      }
+    }
+  });
+}
+
+void Viewer::stop() {
+  running_ = false;
+  if (lcm_thread_.joinable()) lcm_thread_.join();
+}
+
+int64_t Viewer::message_time() const {
+  int64_t t = 0;
+  for (const auto& r : renderers_) t = std::max(t, r->latest_utime());
+  return t;
+}
+
+void Viewer::compose_image_pane(bool force) {
+  bool changed = force;
+  if (camera_ && camera_->enabled()) {
+    cv::Mat img;
+    if (camera_->take_image(img)) {
+      base_image_ = img;
+      changed = true;
+    }
+  }
+  if (!changed || base_image_.empty()) return;
+  cv::Mat canvas;
+  if (base_image_.channels() == 1)
+    cv::cvtColor(base_image_, canvas, cv::COLOR_GRAY2BGR);
+  else
+    canvas = base_image_.clone();
+  for (auto& r : renderers_)
+    if (r->enabled() && r.get() != camera_) r->draw_image(canvas);
+  if (selection_) cv::rectangle(canvas, *selection_, cv::Scalar(255, 255, 0), 1);
+  image_pane_->show(canvas);
+}
+
+bool Viewer::render_frame() {
+  bool overlay_changed = selection_.has_value();
+  bool changed = false;
+  for (auto& r : renderers_) {
+    if (!r->enabled() || r.get() == camera_) continue;
+    if (r->update()) {
+      changed = true;
+      overlay_changed = true;  // cheap to redraw; overlays are few
+    }
+  }
+  if (paused_) return false;
+  compose_image_pane(overlay_changed);
+  layout_.window->Render();
+  ++frames_rendered_;
+  return changed;
+}
+
+void Viewer::snapshot(const std::string& png_path) {
+  compose_image_pane(true);
+  layout_.window->Render();
+  auto grab = vtkSmartPointer<vtkWindowToImageFilter>::New();
+  grab->SetInput(layout_.window);
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  auto writer = vtkSmartPointer<vtkPNGWriter>::New();
+  writer->SetFileName(png_path.c_str());
+  writer->SetInputConnection(grab->GetOutputPort());
+  writer->Write();
+  if (writer->GetErrorCode() != 0) throw std::runtime_error("cannot write snapshot " + png_path);
+}
+
+void Viewer::begin_selection(double x, double y) {
+  const auto p = image_pane_->display_to_image(x, y);
+  if (!p) return;
+  selection_start_ = *p;
+  selection_ = cv::Rect2d(*p, *p);
+}
+
+void Viewer::drag_selection(double x, double y) {
+  if (!selection_) return;
+  // Outside the pane the selection is clamped to its border.
+  int* size = layout_.window->GetSize();
+  double vp[4];
+  layout_.image->GetViewport(vp);
+  x = std::clamp(x, vp[0] * size[0], vp[2] * size[0] - 1);
+  y = std::clamp(y, vp[1] * size[1], vp[3] * size[1] - 1);
+  if (const auto p = image_pane_->display_to_image(x, y)) selection_ = cv::Rect2d(selection_start_, *p);
+}
+
+std::optional<cv::Rect2d> Viewer::end_selection(double x, double y) {
+  if (!selection_) return std::nullopt;
+  drag_selection(x, y);
+  const cv::Size s = image_pane_->image_size();
+  cv::Rect2d box = *selection_ & cv::Rect2d(0, 0, s.width, s.height);
+  selection_.reset();
+  if (box.width < 4 || box.height < 4) return std::nullopt;  // a click, not a box
+  send_track_command(aerie::track_cmd_t::INIT, box);
+  return box;
+}
+
+void Viewer::send_track_command(int8_t command, const std::optional<cv::Rect2d>& box) {
+  aerie::track_cmd_t cmd{};
+  cmd.utime = message_time();
+  cmd.seq = cmd_seq_++;
+  cmd.command = command;
+  cmd.tracker = current_tracker();
+  cmd.camera = options_.image_channel;
+  if (box) {
+    cmd.x = box->x;
+    cmd.y = box->y;
+    cmd.width = box->width;
+    cmd.height = box->height;
+  }
+  cmd.nparams = 0;
+  bus_.publish(options_.track_cmd_channel, cmd);
+  spdlog::info("TRACK_CMD {} tracker={} box=({:.0f},{:.0f},{:.0f},{:.0f})", command, cmd.tracker, cmd.x, cmd.y,
+               cmd.width, cmd.height);
+}
+
+void Viewer::on_key(const std::string& key) {
+  if (key == "t") {
+    tracker_index_ = (tracker_index_ + 1) % options_.trackers.size();
+    send_track_command(aerie::track_cmd_t::SET_TRACKER);
+  } else if (key == "x") {
+    send_track_command(aerie::track_cmd_t::STOP);
+  } else if (key == "r") {
+    send_track_command(aerie::track_cmd_t::RESET);
+  } else if (key == "c") {
+    image_pane_->reset_view();
+    layout_.scene->ResetCamera();
+  } else if (key == "p") {
+    paused_ = !paused_;
+  } else if (key == "h") {
+    help_->text->SetVisibility(!help_->text->GetVisibility());
+  } else if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
+    const size_t i = static_cast<size_t>(key[0] - '1');
+    if (i < renderers_.size()) renderers_[i]->set_enabled(!renderers_[i]->enabled());
+  } else {
+    for (auto& r : renderers_)
+      if (r->enabled() && r->on_key(key)) break;
+  }
+  update_help_text();
+}
+
+void Viewer::update_help_text() {
+  std::string s = "drag: track box  t: tracker [" + current_tracker() + "]  x: stop  r: reset  c: view  p: pause" +
+                  (paused_ ? " (PAUSED)" : "") + "\n";
+  for (size_t i = 0; i < renderers_.size() && i < 9; ++i)
+    s += std::to_string(i + 1) + (renderers_[i]->enabled() ? ":[x] " : ":[ ] ") + renderers_[i]->name() +
+         (i % 5 == 4 ? "\n" : "  ");
+  help_->text->SetInput(s.c_str());
+}
+
+namespace {
+
+// Routes mouse and keys to the viewer: left-drag on the camera pane selects a box;
+// elsewhere the trackball camera style moves the 3D scene.
+class InteractorStyle : public vtkInteractorStyleTrackballCamera {
+ public:
+  static InteractorStyle* New();
+  vtkTypeMacro(InteractorStyle, vtkInteractorStyleTrackballCamera)
+  Viewer* viewer = nullptr;
+  bool selecting = false;
+
+  void OnLeftButtonDown() override {
+    int* p = GetInteractor()->GetEventPosition();
+    if (viewer->image_pane().contains_display(p[0], p[1])) {
+      selecting = true;
+      viewer->begin_selection(p[0], p[1]);
+      return;
+    }
+    vtkInteractorStyleTrackballCamera::OnLeftButtonDown();
+  }
+  void OnMouseMove() override {
+    if (selecting) {
+      int* p = GetInteractor()->GetEventPosition();
+      viewer->drag_selection(p[0], p[1]);
+      return;
+    }
+    vtkInteractorStyleTrackballCamera::OnMouseMove();
+  }
+  void OnLeftButtonUp() override {
+    if (selecting) {
+      int* p = GetInteractor()->GetEventPosition();
+      viewer->end_selection(p[0], p[1]);
+      selecting = false;
+      return;
+    }
+    vtkInteractorStyleTrackballCamera::OnLeftButtonUp();
+  }
+  void OnChar() override {
+    const char* sym = GetInteractor()->GetKeySym();
+    const std::string key = sym ? sym : "";
+    if (key == "q" || key == "Escape") {
+      GetInteractor()->ExitCallback();
+      return;
+    }
+    viewer->on_key(key.size() == 1 ? key : std::string(1, GetInteractor()->GetKeyCode()));
+  }
+};
+vtkStandardNewMacro(InteractorStyle);
+
+void on_timer(vtkObject*, unsigned long, void* client, void*) {
+  auto* v = static_cast<Viewer*>(client);
+  v->render_frame();
+  if (bus::stop_requested()) v->layout().window->GetInteractor()->ExitCallback();
+}
+
+}  // namespace
+
+void Viewer::run_interactive(double fps) {
+  auto interactor = vtkSmartPointer<vtkRenderWindowInteractor>::New();
+  interactor->SetRenderWindow(layout_.window);
+  auto style = vtkSmartPointer<InteractorStyle>::New();
+  style->viewer = this;
+  style->SetDefaultRenderer(layout_.scene);
+  interactor->SetInteractorStyle(style);
+  interactor->Initialize();
+  auto cb = vtkSmartPointer<vtkCallbackCommand>::New();
+  cb->SetCallback(on_timer);
+  cb->SetClientData(this);
+  interactor->AddObserver(vtkCommand::TimerEvent, cb);
+  interactor->CreateRepeatingTimer(static_cast<unsigned long>(1000.0 / fps));
+  interactor->Start();
+}
+
+}  // namespace aerie::viewer

@@ -1,0 +1,96 @@
+#pragma once
+// The ground viewer: renderers (plugins) fed by LCM in a handling thread, drawn by the
+// render thread into one VTK window (layout.hpp). Operator interaction: drag a box on
+// the camera pane to start tracking it (TRACK_CMD INIT with the chosen tracker), keys
+// to stop/reset tracking, toggle renderers, reset the camera and pause the display.
+#include <aerie/track_cmd_t.hpp>
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common/bus/bus.hpp"
+#include "ground/viewer/image_pane.hpp"
+#include "ground/viewer/layout.hpp"
+#include "ground/viewer/renderer.hpp"
+#include "ground/viewer/renderers/camera.hpp"
+
+namespace aerie::viewer {
+
+struct ViewerOptions {
+  int width = 1280;
+  int height = 800;
+  bool offscreen = false;
+  std::string image_channel = "CAM_LEFT";
+  std::string track_cmd_channel = "TRACK_CMD";
+  std::vector<std::string> trackers = {"amcmr-ct", "am3", "ipsl-mr", "ct", "mil", "ipsl"};
+};
+
+class Viewer {
+ public:
+  Viewer(bus::Bus& bus, ViewerOptions options);
+  ~Viewer();
+
+  // Adds the standard renderers (camera pane, tracking, 3D scene, charts, procman panel).
+  void add_default_renderers();
+  Renderer& add(std::unique_ptr<Renderer> renderer);
+  Renderer* find(const std::string& name) const;
+  const std::vector<std::unique_ptr<Renderer>>& renderers() const { return renderers_; }
+
+  // Subscribes every renderer and starts the LCM handling thread.
+  void start();
+  void stop();
+
+  // Render thread: pulls the latest data into every enabled renderer and renders the
+  // window (unless paused). Returns true when anything changed.
+  bool render_frame();
+  // Writes a PNG of the whole window (renders first).
+  void snapshot(const std::string& png_path);
+
+  // Operator interaction (display coordinates: pixels, origin bottom-left).
+  void begin_selection(double x, double y);
+  void drag_selection(double x, double y);
+  // Sends TRACK_CMD INIT for the selected box in image pixels; returns it when sent.
+  std::optional<cv::Rect2d> end_selection(double x, double y);
+  // Keys: 't' next tracker, 'x' stop, 'r' reset tracking, 'c' reset cameras,
+  // 'p' pause/resume, '1'..'9' toggle renderer N, 'h' toggle the help text.
+  void on_key(const std::string& key);
+  void send_track_command(int8_t command, const std::optional<cv::Rect2d>& box = std::nullopt);
+
+  const std::string& current_tracker() const { return options_.trackers[tracker_index_]; }
+  bool paused() const { return paused_; }
+  Layout& layout() { return layout_; }
+  ImagePane& image_pane() { return *image_pane_; }
+  int64_t frames_rendered() const { return frames_rendered_; }
+  // Latest message time seen (utime, µs): the viewer's clock, so replays follow log time.
+  int64_t message_time() const;
+  // Runs the interactive window until it is closed or stop is requested.
+  void run_interactive(double fps);
+
+ private:
+  void compose_image_pane(bool force);
+  void update_help_text();
+
+  bus::Bus& bus_;
+  ViewerOptions options_;
+  Layout layout_;
+  std::unique_ptr<ImagePane> image_pane_;
+  std::vector<std::unique_ptr<Renderer>> renderers_;
+  CameraRenderer* camera_ = nullptr;
+  cv::Mat base_image_;
+  std::optional<cv::Rect2d> selection_;  // image pixels, while dragging
+  cv::Point2d selection_start_;
+  size_t tracker_index_ = 0;
+  bool paused_ = false;
+  int64_t frames_rendered_ = 0;
+  int64_t cmd_seq_ = 0;
+  std::atomic<bool> running_{false};
+  std::thread lcm_thread_;
+  struct Help;
+  std::unique_ptr<Help> help_;
+};
+
+}  // namespace aerie::viewer

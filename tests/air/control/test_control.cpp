@@ -1,0 +1,250 @@
+// aerie-control: heading from pose, the control loop (limits, stale -> hover, run-time
+// controller replacement) and the node in-process over memq://.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <aerie/process_status_t.hpp>
+#include <cmath>
+
+#include "air/control/control_config.hpp"
+#include "air/control/control_loop.hpp"
+#include "air/control/control_node.hpp"
+#include "air/control/heading_from_pose.hpp"
+#include "common/flc/flc_io.hpp"
+#include "common/util/time.hpp"
+
+using namespace aerie;
+using namespace aerie::control;
+
+namespace {
+
+void quaternion(const Eigen::Quaterniond& q, double out[4]) {
+  out[0] = q.w();
+  out[1] = q.x();
+  out[2] = q.y();
+  out[3] = q.z();
+}
+
+// Camera turned by `heading` degrees to the right (clockwise seen from above) in VO's
+// frame (y down, zero heading along z).
+aerie::pose_t vo_pose(int64_t utime, double heading) {
+  aerie::pose_t p{};
+  p.utime = utime;
+  p.seq = utime / 1000;
+  p.status = aerie::pose_t::OK;
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(-heading * M_PI / 180.0, Eigen::Vector3d(0, -1, 0)));
+  quaternion(q, p.orientation);
+  return p;
+}
+
+flc::FlcSpec tuned() {
+  flc::FlcSpec s = flc::thesis_initial();
+  s.id = "tuned";
+  s.set_parameter("Kp", 3.0);
+  s.set_parameter("Kd", 0.01);
+  s.set_parameter("Ki", -0.01);
+  return s;
+}
+
+void drain(bus::Bus& bus) {
+  while (bus.handle(0) > 0) {
+  }
+}
+
+}  // namespace
+
+TEST(HeadingFromPose, VoAndZUpFrames) {
+  double q[4];
+  const HeadingFrame vo;
+  for (double h : {0.0, 30.0, -75.0, 179.0}) {
+    quaternion(Eigen::Quaterniond(Eigen::AngleAxisd(-h * M_PI / 180.0, Eigen::Vector3d(0, -1, 0))), q);
+    EXPECT_NEAR(heading_from_quaternion(q, vo), h, 1e-9) << h;
+  }
+  // A pitched camera (looking 20 deg down) has the same heading.
+  quaternion(Eigen::Quaterniond(Eigen::AngleAxisd(-40 * M_PI / 180.0, Eigen::Vector3d(0, -1, 0)) *
+                                Eigen::AngleAxisd(-20 * M_PI / 180.0, Eigen::Vector3d(1, 0, 0))),
+             q);
+  EXPECT_NEAR(heading_from_quaternion(q, vo), 40.0, 1e-9);
+  // z-up world, zero heading along +y, camera axes: x right, y down, z along the heading.
+  HeadingFrame zup;
+  zup.up = {0, 0, 1};
+  zup.forward = {0, 1, 0};
+  const double h = 25.0 * M_PI / 180.0;
+  Eigen::Matrix3d r;
+  r.col(0) = Eigen::Vector3d(std::cos(h), -std::sin(h), 0);
+  r.col(1) = Eigen::Vector3d(0, 0, -1);
+  r.col(2) = Eigen::Vector3d(std::sin(h), std::cos(h), 0);
+  quaternion(Eigen::Quaterniond(r), q);
+  EXPECT_NEAR(heading_from_quaternion(q, zup), 25.0, 1e-9);
+  const double bad[4] = {2, 0, 0, 0};
+  EXPECT_THROW(heading_from_quaternion(bad, vo), std::invalid_argument);
+  quaternion(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d(1, 0, 0))), q);  // looking straight up/down
+  EXPECT_THROW(heading_from_quaternion(q, vo), std::invalid_argument);
+}
+
+TEST(ControlLoop, HoverActiveLimitsAndStaleFallback) {
+  ControlConfig cfg;
+  cfg.forward_speed_m_s = 0.6;
+  cfg.stale_timeout_s = 0.5;
+  cfg.limits.max_yaw_rate_deg_s = 40.0;
+  ControlLoop loop(tuned(), cfg);
+  EXPECT_EQ(loop.command(0).mode, Mode::kHover);
+  EXPECT_EQ(loop.command(0).yaw_rate_deg_s, 0.0);
+  // First heading 10 deg: relative reference 100 deg, error 90 -> saturated to the limit.
+  ASSERT_TRUE(loop.on_heading(1'000'000, 10.0, 5'000'000));
+  Command c = loop.command(5'000'000);
+  EXPECT_EQ(c.mode, Mode::kActive);
+  EXPECT_DOUBLE_EQ(c.reference_deg, 100.0);
+  EXPECT_DOUBLE_EQ(c.error_deg, 90.0);
+  EXPECT_DOUBLE_EQ(c.yaw_rate_deg_s, 40.0);
+  EXPECT_DOUBLE_EQ(c.forward_speed_m_s, 0.6);
+  EXPECT_EQ(c.source_utime, 1'000'000);
+  EXPECT_EQ(c.controller_id, "tuned");
+  // Older or repeated message time is ignored.
+  EXPECT_FALSE(loop.on_heading(1'000'000, 50.0, 5'010'000));
+  EXPECT_FALSE(loop.on_heading(2'000'000, NAN, 5'010'000));
+  // Held at the reference, the command settles to ~0 (the integral's small share).
+  for (int k = 1; k <= 10; ++k) ASSERT_TRUE(loop.on_heading(1'000'000 + k * 33'333, 100.0, 5'000'000 + k * 33'333));
+  EXPECT_LT(std::abs(loop.command(5'333'330).yaw_rate_deg_s), 2.0);
+  // No heading for longer than the timeout: fallback hover, no speed, no turn.
+  c = loop.command(5'333'330 + 600'000);
+  EXPECT_EQ(c.mode, Mode::kFallbackHover);
+  EXPECT_EQ(c.yaw_rate_deg_s, 0.0);
+  EXPECT_EQ(c.forward_speed_m_s, 0.0);
+  EXPECT_EQ(loop.command(5'333'330 + 400'000).mode, Mode::kActive);
+  // Input resumes: active again.
+  ASSERT_TRUE(loop.on_heading(3'000'000, 99.0, 7'000'000));
+  EXPECT_EQ(loop.command(7'000'000).mode, Mode::kActive);
+}
+
+TEST(ControlLoop, RefusesAnInvalidControllerAndKeepsTheOld) {
+  ControlLoop loop(tuned(), ControlConfig{});
+  flc::FlcSpec bad = tuned();
+  bad.id = "bad";
+  bad.inputs[0].positions[1] = -100;  // outside the range and out of order
+  const auto reason = loop.set_controller(bad);
+  ASSERT_TRUE(reason.has_value());
+  EXPECT_NE(reason->find("error"), std::string::npos) << *reason;
+  EXPECT_EQ(loop.controller().id, "tuned");
+  flc::FlcSpec good = tuned();
+  good.id = "good";
+  EXPECT_FALSE(loop.set_controller(good).has_value());
+  EXPECT_EQ(loop.controller().id, "good");
+  ControlConfig c;
+  c.stale_timeout_s = 0;
+  EXPECT_THROW(ControlLoop(tuned(), c), std::invalid_argument);
+}
+
+TEST(ControlConfig, ConfigFileAndErrors) {
+  const auto setup = node_setup(util::Config::load(std::string(AERIE_SOURCE_DIR) + "/config/control.yaml"));
+  EXPECT_EQ(setup.controller.id, "thesis-initial");
+  EXPECT_EQ(setup.options.input, NodeOptions::Input::kVoPose);
+  EXPECT_DOUBLE_EQ(setup.options.control.reference_deg, 90.0);
+  CliOverrides cli;
+  cli.input = "gt";
+  cli.reference_deg = -90.0;
+  const auto gt = node_setup(util::Config(), cli);
+  EXPECT_EQ(gt.options.input, NodeOptions::Input::kGtPose);
+  EXPECT_EQ(gt.options.frame.up, Eigen::Vector3d(0, 0, 1));
+  EXPECT_DOUBLE_EQ(gt.options.control.reference_deg, -90.0);
+  try {
+    node_setup(util::Config::parse("stale_timeout_s: -1\n", "c.yaml"));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("c.yaml"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(node_setup(util::Config::parse("stale_timout_s: 1\n", "c.yaml")), std::runtime_error);  // misspelt key
+}
+
+TEST(ControlNode, RefusesMalformedParametersAndTimesOutToHover) {
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "control");
+  NodeOptions opt;
+  opt.control.stale_timeout_s = 0.3;
+  ControlNode node(bus, status, tuned(), opt);
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  aerie::process_status_t last_status{};
+  bus.subscribe<aerie::process_status_t>("STATUS_CONTROL",
+                                         [&](const aerie::process_status_t& m, const bus::ReceiveInfo&) { last_status = m; });
+  auto counter = [&](const std::string& name) {
+    for (int i = 0; i < last_status.ncounters; ++i)
+      if (last_status.counter_names[i] == name) return last_status.counter_values[i];
+    return int64_t{-1};
+  };
+
+  // A heading arrives; the command published right after uses it.
+  bus.publish("VO_POSE", vo_pose(1'000'000, 0.0));
+  drain(bus);
+  int64_t now = util::wall_utime();
+  node.publish_command(now);
+  drain(bus);
+  ASSERT_EQ(cmds.size(), 1u);
+  EXPECT_EQ(cmds[0].mode, aerie::control_cmd_t::ACTIVE);
+  EXPECT_EQ(cmds[0].utime, 1'000'000);
+  EXPECT_GT(cmds[0].yaw_rate_deg_s, 10.0f);  // 90 deg to the right: turn right
+  EXPECT_EQ(cmds[0].controller_id, "tuned");
+
+  // Malformed controllers are refused with a reason; the old one stays.
+  aerie::flc_params_t bad{};
+  bad.controller_id = "broken-fll";
+  bad.fll = "Engine: x\nInputVariable: e\n  term: A Gaussian 0 1\n";
+  bus.publish("FLC_PARAMS", bad);
+  aerie::flc_params_t bad2{};
+  bad2.controller_id = "bad-position";
+  bad2.names = {"error.Left"};
+  bad2.values = {-120.0};  // beyond the range
+  bad2.nparams = 1;
+  bus.publish("FLC_PARAMS", bad2);
+  aerie::flc_params_t bad3 = bad2;
+  bad3.controller_id = "unknown-name";
+  bad3.names = {"pitch.Left"};
+  bad3.values = {1.0};
+  bus.publish("FLC_PARAMS", bad3);
+  const uint8_t junk[5] = {1, 2, 3, 4, 5};
+  bus.raw().publish("FLC_PARAMS", junk, sizeof(junk));  // not even a flc_params_t
+  drain(bus);
+  status.publish_now();
+  drain(bus);
+  EXPECT_EQ(counter("params_refused"), 3);
+  EXPECT_EQ(counter("FLC_PARAMS.malformed"), 1);
+  EXPECT_EQ(last_status.health, aerie::process_status_t::WARN);
+  EXPECT_NE(last_status.message.find("unknown-name"), std::string::npos) << last_status.message;
+  EXPECT_NE(last_status.message.find("pitch"), std::string::npos) << last_status.message;
+  EXPECT_EQ(node.loop().controller().id, "tuned");
+
+  // A valid one (the FLL of another controller) is taken.
+  flc::FlcSpec other = tuned();
+  other.set_parameter("Kp", 2.0);
+  aerie::flc_params_t good{};
+  good.controller_id = "ce-sfmf";
+  good.fll = flc::to_fll(other);
+  bus.publish("FLC_PARAMS", good);
+  drain(bus);
+  EXPECT_EQ(node.loop().controller().id, "ce-sfmf");
+  EXPECT_DOUBLE_EQ(node.loop().controller().parameter("Kp"), 2.0);
+
+  // No heading for longer than the timeout: the fixed-rate commands fall back to hover.
+  cmds.clear();
+  now = util::wall_utime();
+  node.tick(now + 100'000);
+  node.tick(now + 110'000);  // within the period: nothing
+  node.tick(now + 500'000);
+  drain(bus);
+  ASSERT_EQ(cmds.size(), 2u);
+  EXPECT_EQ(cmds[0].mode, aerie::control_cmd_t::ACTIVE);
+  EXPECT_EQ(cmds[1].mode, aerie::control_cmd_t::FALLBACK_HOVER);
+  EXPECT_EQ(cmds[1].yaw_rate_deg_s, 0.0f);
+  EXPECT_EQ(cmds[1].velocity_body[0], 0.0f);
+  EXPECT_EQ(cmds[1].controller_id, "ce-sfmf");
+
+  // A lost VO pose is not a heading.
+  aerie::pose_t lost = vo_pose(2'000'000, 10.0);
+  lost.status = aerie::pose_t::LOST;
+  bus.publish("VO_POSE", lost);
+  drain(bus);
+  status.publish_now();
+  drain(bus);
+  EXPECT_EQ(counter("pose_not_ok"), 1);
+  EXPECT_EQ(counter("poses"), 1);
+}

@@ -1,0 +1,211 @@
+// aerie-track's node logic over memq://: frames and commands in, TRACK / TARGET_POSE out.
+#include <gtest/gtest.h>
+
+#include <aerie/target_pose_t.hpp>
+
+#include "air/track/node/track_node.hpp"
+#include "common/image/image_message.hpp"
+#include "air/track/factory.hpp"
+#include "tests/air/track/synthetic.hpp"
+#include "tests/support/test_support.hpp"
+
+using namespace aerie::track;
+using aerie::track::test::Motion;
+using aerie::track::test::Scene;
+
+namespace {
+
+class NodeTest : public ::testing::Test {
+ protected:
+  NodeTest() : bus_("memq://"), scene_({240, 180}, {40, 32}) {
+    bus_.subscribe<aerie::track_t>("TRACK", [this](const aerie::track_t& m, const aerie::bus::ReceiveInfo&) {
+      tracks_.push_back(m);
+    });
+    bus_.subscribe<aerie::target_pose_t>("TARGET_POSE", [this](const aerie::target_pose_t& m,
+                                                               const aerie::bus::ReceiveInfo&) { poses_.push_back(m); });
+  }
+  // Delivers everything published so far, lets the worker finish, delivers its output.
+  void settle(TrackNode& node) {
+    for (int round = 0; round < 3; ++round) {
+      while (bus_.handle(0) > 0) {
+      }
+      ASSERT_TRUE(node.wait_idle(5000));
+    }
+    while (bus_.handle(0) > 0) {
+    }
+  }
+  Motion motion(int i) const {
+    Motion m;
+    m.centre = {80 + 2.0 * i, 90 + 1.0 * i};
+    return m;
+  }
+  aerie::image_t frame(int i) const {
+    return aerie::image::to_message(scene_.render(motion(i)), 1'000'000 + 33'333 * i, i);
+  }
+  void send_init(const cv::Rect2d& box, const std::string& tracker = "") {
+    aerie::track_cmd_t c{};
+    c.command = aerie::track_cmd_t::INIT;
+    c.tracker = tracker;
+    c.x = box.x, c.y = box.y, c.width = box.width, c.height = box.height;
+    c.nparams = 1;
+    c.param_names = {"search_radius"};
+    c.param_values = {"16"};
+    bus_.publish("TRACK_CMD", c);
+  }
+
+  aerie::bus::Bus bus_;
+  Scene scene_;
+  std::vector<aerie::track_t> tracks_;
+  std::vector<aerie::target_pose_t> poses_;
+};
+
+}  // namespace
+
+TEST_F(NodeTest, InitThenTracksEveryFrameWithTheSourceUtime) {
+  NodeOptions opt;
+  opt.target.width_m = 0.8;  // the 40 x 32 px target is 0.8 x 0.64 m
+  opt.target.height_m = 0.64;
+  opt.camera = aerie::camera::CameraModel{};
+  opt.camera->fx = opt.camera->fy = 200;
+  opt.camera->cx = 120, opt.camera->cy = 90;
+  TrackNode node(bus_, opt);
+
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  ASSERT_EQ(tracks_.size(), 1u);
+  EXPECT_EQ(tracks_[0].status, aerie::track_t::IDLE);  // no target yet
+
+  send_init(scene_.box(motion(0)), "amcmr-ct");  // INIT uses the newest frame: frame 0
+  settle(node);
+  for (int i = 1; i <= 15; ++i) {
+    bus_.publish("CAM_LEFT", frame(i));
+    settle(node);
+  }
+  ASSERT_EQ(tracks_.size(), 16u);
+  for (size_t k = 1; k < tracks_.size(); ++k) {
+    const auto& t = tracks_[k];
+    EXPECT_EQ(t.utime, 1'000'000 + 33'333 * static_cast<int64_t>(k));
+    EXPECT_EQ(t.tracker, "amcmr-ct");
+    EXPECT_EQ(t.camera, "CAM_LEFT");
+    EXPECT_NE(t.status, aerie::track_t::IDLE);
+  }
+  const auto& last = tracks_.back();
+  const Motion truth = motion(15);
+  EXPECT_NEAR(last.x, truth.centre.x, 4);
+  EXPECT_NEAR(last.y, truth.centre.y, 4);
+  ASSERT_GE(last.nlevels, 1);
+  EXPECT_GT(last.levels[0].evaluated, 0);
+  EXPECT_EQ(last.levels[0].npoints, static_cast<int>(last.levels[0].u.size()));
+  EXPECT_LE(last.levels[0].npoints, 200);
+  // TARGET_POSE for every tracked frame: a 0.8 m target 40 px wide at f = 200 px is 4 m away
+  ASSERT_EQ(poses_.size(), 15u);
+  EXPECT_EQ(poses_.back().utime, last.utime);
+  EXPECT_NEAR(poses_.back().position[2], 200 * 0.8 / last.width, 1e-6);
+  EXPECT_NEAR(poses_.back().position[2], 4.0, 0.4);  // the target keeps its size
+  EXPECT_NEAR(poses_.back().position[0], (last.x - 120) / 200 * poses_.back().position[2], 1e-6);
+  EXPECT_EQ(node.counter("frames_received"), 16);  // frame 0 came before the INIT
+  EXPECT_EQ(node.counter("frames_processed") + node.counter("frames_skipped") + 1, node.counter("frames_received"));
+}
+
+TEST_F(NodeTest, BadMessagesAndCommandsAreCountedNotFatal) {
+  TrackNode node(bus_, NodeOptions{});
+  aerie::bus::StatusReporter status(bus_, "track");
+  const uint8_t junk[5] = {1, 2, 3, 4, 5};
+  bus_.raw().publish("CAM_LEFT", junk, sizeof(junk));  // not an image_t
+  aerie::image_t bad = frame(0);
+  bad.size = 10;
+  bad.data.resize(10);  // inconsistent payload: decodes as an error
+  bus_.publish("CAM_LEFT", bad);
+  settle(node);
+  send_init({10, 10, 30, 30}, "no-such-tracker");
+  bus_.publish("CAM_LEFT", frame(1));
+  settle(node);
+  send_init({230, 10, 30, 30});  // outside the 240x180 image
+  aerie::track_cmd_t reset{};
+  reset.command = aerie::track_cmd_t::RESET;  // nothing to reset
+  bus_.publish("TRACK_CMD", reset);
+  bus_.publish("CAM_LEFT", frame(2));
+  settle(node);
+  EXPECT_EQ(node.counter("decode_errors"), 1);
+  EXPECT_EQ(node.counter("command_errors"), 3);
+  EXPECT_EQ(bus_.subscriptions()[2]->counters().malformed, 1);  // CAM_LEFT subscription
+  node.report(status);
+  EXPECT_EQ(status.counter("command_errors"), 3);
+  // still alive: a good INIT tracks, STOP returns to IDLE
+  send_init(scene_.box(motion(3)));
+  bus_.publish("CAM_LEFT", frame(3));
+  settle(node);
+  bus_.publish("CAM_LEFT", frame(4));
+  settle(node);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  EXPECT_EQ(tracks_.back().tracker, "amcmr-ct");
+  aerie::track_cmd_t stop{};
+  stop.command = aerie::track_cmd_t::STOP;
+  bus_.publish("TRACK_CMD", stop);
+  bus_.publish("CAM_LEFT", frame(5));
+  settle(node);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::IDLE);
+}
+
+TEST_F(NodeTest, StereoLeftImageAndInitFromGroundTruth) {
+  NodeOptions opt;
+  opt.camera_channel = "CAM_STEREO";
+  opt.stereo = true;
+  opt.init_from_gt = 2;
+  opt.tracker = "ct";
+  opt.target.width_m = opt.target.height_m = 1.0;
+  TrackNode node(bus_, opt);
+  for (int i = 0; i < 6; ++i) {
+    const cv::Rect2d box = scene_.box(motion(i));
+    aerie::gt_box_t gt{};
+    gt.utime = 1'000'000 + 33'333 * i;
+    gt.target = "helipad";
+    gt.visible = true;
+    gt.x = box.x, gt.y = box.y, gt.width = box.width, gt.height = box.height;
+    bus_.publish("GT_TRACK", gt);
+    aerie::stereo_image_t st{};
+    st.utime = gt.utime;
+    st.seq = i;
+    st.left = frame(i);
+    st.right = frame(i);
+    st.fx = st.fy = 300, st.cx = 120, st.cy = 90, st.baseline_m = 0.1;
+    bus_.publish("CAM_STEREO", st);
+    settle(node);
+  }
+  ASSERT_EQ(tracks_.size(), 6u);
+  EXPECT_EQ(tracks_[1].status, aerie::track_t::IDLE);
+  EXPECT_EQ(tracks_[2].status, aerie::track_t::TRACKING);  // 2 frames seen: initialised on the third
+  EXPECT_EQ(tracks_[2].tracker, "ct");
+  EXPECT_NEAR(tracks_[2].x, motion(2).centre.x, 1e-9);
+  EXPECT_NEAR(tracks_.back().x, motion(5).centre.x, 3);
+  ASSERT_FALSE(poses_.empty());  // intrinsics from the stereo message
+  EXPECT_NEAR(poses_.back().position[2], 300.0 * 1.0 / std::sqrt(tracks_.back().width * tracks_.back().height), 1e-6);
+}
+
+TEST(NodeOptions, ReadsTheYamlSectionsAndRejectsBadValues) {
+  const auto cfg = aerie::util::Config::parse(R"(
+node: {camera_channel: CAM_MONO, tracker: am3, max_points: 50}
+target: {name: helipad, width_m: 1.2}
+camera: {fx: 400, cx: 320, cy: 240}
+trackers: {am3: {search_radius: 24}}
+)",
+                                              "track.yaml");
+  const NodeOptions o = node_options(cfg);
+  EXPECT_EQ(o.camera_channel, "CAM_MONO");
+  EXPECT_EQ(o.tracker, "am3");
+  EXPECT_EQ(o.max_points, 50);
+  EXPECT_EQ(o.target_name, "helipad");
+  EXPECT_DOUBLE_EQ(o.target.height_m, 1.2);
+  ASSERT_TRUE(o.camera.has_value());
+  EXPECT_DOUBLE_EQ(o.camera->fy, 400);
+  EXPECT_EQ(o.trackers.section("am3").get("search_radius", 0), 24);
+  EXPECT_THROW(node_options(aerie::util::Config::parse("node: {tracker: kcf}")), std::runtime_error);
+  EXPECT_THROW(node_options(aerie::util::Config::parse("target: {width_m: -1}")), std::runtime_error);
+}
+
+TEST(NodeOptions, TheShippedConfigIsValidForEveryTracker) {
+  const auto cfg = aerie::util::Config::load((aerie::test::source_dir() / "config" / "track.yaml").string());
+  const NodeOptions o = node_options(cfg);
+  EXPECT_EQ(o.camera_channel, "CAM_LEFT");
+  for (const auto& name : aerie_tracker_names()) EXPECT_NO_THROW(make_tracker(name, o.trackers.section(name))) << name;
+}

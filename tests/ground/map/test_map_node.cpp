@@ -1,0 +1,89 @@
+// The aerie-map executable: saves the map at exit (SIGINT) and continues a saved map.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ground/map/occupancy.hpp"
+#include "tests/support/test_support.hpp"
+
+extern char** environ;
+
+namespace {
+
+pid_t spawn(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  EXPECT_EQ(posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+  return pid;
+}
+
+int wait_exit(pid_t pid, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -2;
+}
+
+// True once the process catches SIGINT (its stop handlers are installed): SigCgt in /proc.
+bool catches_sigint(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1;
+  return false;
+}
+
+// Runs aerie-map (in-process LCM: nothing to receive) and stops it with SIGINT.
+int run_and_interrupt(std::vector<std::string> args) {
+  args.insert(args.begin(), {AERIE_MAP_EXE, "--lcm-url", "memq://", "--log-level", "warn"});
+  const pid_t pid = spawn(args);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (!catches_sigint(pid) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // into the main loop
+  kill(pid, SIGINT);
+  return wait_exit(pid, 20.0);
+}
+
+}  // namespace
+
+TEST(MapNode, SavesAtExitAndContinuesASavedMap) {
+  const auto dir = aerie::test::scratch_dir("node");
+  // A map to continue from.
+  aerie::map::OccupancyMap map;
+  map.insert_frame({{2.05f, 0.05f, 0.05f}}, {0.05f, 0.05f, 0.05f});
+  const auto start = (dir / "start.ot").string();
+  map.save(start);
+
+  const auto saved = (dir / "saved.bt").string();
+  ASSERT_EQ(run_and_interrupt({"--load", start, "--save", saved}), 0);
+  ASSERT_TRUE(std::filesystem::exists(saved));
+  aerie::map::OccupancyMap back;
+  back.load(saved);
+  EXPECT_EQ(back.occupancy({2.05, 0.05, 0.05}).state, aerie::map::Occupancy::Occupied);
+  EXPECT_EQ(back.occupancy({1.05, 0.05, 0.05}).state, aerie::map::Occupancy::Free);
+}
+
+TEST(MapNode, BadArgumentsFailWithACode) {
+  const auto dir = aerie::test::scratch_dir("bad");
+  EXPECT_EQ(wait_exit(spawn({AERIE_MAP_EXE, "--lcm-url", "memq://", "--save", (dir / "map.txt").string()}), 20.0), 1);
+  EXPECT_NE(wait_exit(spawn({AERIE_MAP_EXE, "--load", (dir / "missing.bt").string()}), 20.0), 0);
+  EXPECT_EQ(wait_exit(spawn({AERIE_MAP_EXE, "--help"}), 20.0), 0);
+}

@@ -1,0 +1,338 @@
+// Each renderer fed with known messages renders the expected content: the tests read
+// pixels of the snapshot, not just that a file exists.
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <chrono>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+
+#include <aerie/control_cmd_t.hpp>
+#include <bot_procman/info2_t.hpp>
+
+#include "common/image/image_message.hpp"
+#include "common/util/time.hpp"
+#include "ground/viewer/renderers/charts.hpp"
+#include "ground/viewer/renderers/panel.hpp"
+#include "ground/viewer/renderers/scene.hpp"
+#include "ground/viewer/viewer.hpp"
+#include "tests/support/test_support.hpp"
+
+using namespace aerie;
+using namespace aerie::viewer;
+
+namespace {
+
+struct Fixture : ::testing::Test {
+  std::unique_ptr<bus::Bus> bus_ptr = std::make_unique<bus::Bus>("memq://");
+  bus::Bus& bus = *bus_ptr;
+  std::unique_ptr<Viewer> viewer;
+
+  void make(int w = 1280, int h = 800) {
+    ViewerOptions o;
+    o.width = w;
+    o.height = h;
+    o.offscreen = true;
+    viewer = std::make_unique<Viewer>(bus, o);
+    viewer->add_default_renderers();
+    viewer->start();
+  }
+  void TearDown() override {
+    if (viewer) viewer->stop();
+  }
+  // Renders until `done` holds (the LCM thread delivers asynchronously), at most 3 s.
+  template <typename F>
+  bool render_until(F done) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+    while (std::chrono::steady_clock::now() < end) {
+      viewer->render_frame();
+      if (done()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+  cv::Mat snapshot() {
+    const auto file = aerie::test::scratch_dir("snap") / "viewer.png";
+    viewer->snapshot(file.string());
+    cv::Mat img = cv::imread(file.string(), cv::IMREAD_COLOR);
+    EXPECT_FALSE(img.empty());
+    return img;
+  }
+  // Window pixel (PNG, origin top-left) of an image-pane pixel.
+  cv::Point window_pixel_of_image(const cv::Point2d& uv) {
+    const cv::Point2d d = viewer->image_pane().image_to_display(uv);
+    return {cvRound(d.x), viewer->layout().window->GetSize()[1] - 1 - cvRound(d.y)};
+  }
+  void publish_image(int64_t utime, uchar value = 90) { publish_image_on(bus, utime, value); }
+  static void publish_image_on(bus::Bus& b, int64_t utime, uchar value = 90) {
+    b.publish("CAM_LEFT", image::to_message(cv::Mat(240, 320, CV_8UC1, cv::Scalar(value)), utime, utime));
+  }
+};
+
+bool near_color(const cv::Mat& img, cv::Point p, const cv::Vec3b& bgr, int radius = 2, int tol = 40) {
+  for (int dy = -radius; dy <= radius; ++dy)
+    for (int dx = -radius; dx <= radius; ++dx) {
+      const cv::Point q = p + cv::Point(dx, dy);
+      if (!cv::Rect({}, img.size()).contains(q)) continue;
+      const cv::Vec3b c = img.at<cv::Vec3b>(q);
+      if (std::abs(c[0] - bgr[0]) < tol && std::abs(c[1] - bgr[1]) < tol && std::abs(c[2] - bgr[2]) < tol) return true;
+    }
+  return false;
+}
+
+aerie::track_t box_track(int64_t utime, double x0, double y0, double x1, double y1) {
+  aerie::track_t t{};
+  t.utime = utime;
+  t.tracker = "ct";
+  t.status = aerie::track_t::TRACKING;
+  t.x = (x0 + x1) / 2;
+  t.y = (y0 + y1) / 2;
+  t.scale = 1;
+  t.width = x1 - x0;
+  t.height = y1 - y0;
+  const double c[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  for (int i = 0; i < 4; ++i) {
+    t.corners[i][0] = c[i][0];
+    t.corners[i][1] = c[i][1];
+  }
+  t.confidence = 0.9f;
+  t.nlevels = 0;
+  return t;
+}
+
+}  // namespace
+
+TEST_F(Fixture, TrackBoxIsDrawnWhereTheMessageSaysInRed) {
+  make();
+  publish_image(1000);
+  bus.publish("TRACK", box_track(1000, 100, 80, 200, 160));
+  aerie::gt_box_t gt{};
+  gt.utime = 1000;
+  gt.visible = true;
+  gt.x = 40;
+  gt.y = 30;
+  gt.width = 30;
+  gt.height = 20;
+  bus.publish("GT_TRACK", gt);
+  ASSERT_TRUE(render_until([&] { return viewer->image_pane().image_size() == cv::Size(320, 240); }));
+  render_until([] { return false; });  // let the overlays arrive
+  const cv::Mat img = snapshot();
+  const cv::Vec3b red(0, 0, 255), green(0, 255, 0), gray(90, 90, 90);
+  // Box edges (left, right, top, bottom midpoints) are red; its centre keeps the image gray.
+  for (cv::Point2d p : {cv::Point2d(100, 120), cv::Point2d(200, 120), cv::Point2d(150, 80), cv::Point2d(150, 160)})
+    EXPECT_TRUE(near_color(img, window_pixel_of_image(p), red)) << "no red box edge at image " << p;
+  EXPECT_TRUE(near_color(img, window_pixel_of_image({150, 120}), gray, 0, 10));
+  EXPECT_FALSE(near_color(img, window_pixel_of_image({150, 120}), red, 3));
+  // Ground-truth box in green.
+  EXPECT_TRUE(near_color(img, window_pixel_of_image({40, 40}), green));
+  EXPECT_TRUE(near_color(img, window_pixel_of_image({70, 40}), green));
+  EXPECT_FALSE(near_color(img, window_pixel_of_image({55, 40}), green, 2));
+  // Disabling the track renderer removes the box.
+  viewer->find("track")->set_enabled(false);
+  publish_image(2000);
+  render_until([] { return false; });
+  EXPECT_FALSE(near_color(snapshot(), window_pixel_of_image({100, 120}), red, 2));
+}
+
+TEST_F(Fixture, BoxSelectionMapsBackToImageCoordinatesAtAnySizeAndZoom) {
+  for (auto [w, h, zoom] : {std::tuple{1280, 800, 1.0}, std::tuple{640, 400, 1.0}, std::tuple{1000, 900, 2.5}}) {
+    bus::Bus bus("memq://");  // a bus per window: its subscriptions live as long as that viewer
+    struct ResetAtScopeEnd {  // declared after the bus, so the viewer goes first
+      std::unique_ptr<Viewer>& v;
+      ~ResetAtScopeEnd() { v.reset(); }
+    } reset_viewer{viewer};
+    ViewerOptions o;
+    o.width = w;
+    o.height = h;
+    o.offscreen = true;
+    viewer = std::make_unique<Viewer>(bus, o);
+    viewer->add_default_renderers();
+    viewer->start();
+    std::vector<aerie::track_cmd_t> cmds;
+    bus.subscribe<aerie::track_cmd_t>("TRACK_CMD", [&](const aerie::track_cmd_t& c, const bus::ReceiveInfo&) {
+      cmds.push_back(c);
+    });
+    publish_image_on(bus, 1000);
+    ASSERT_TRUE(render_until([&] { return viewer->image_pane().image_size() == cv::Size(320, 240); }));
+    viewer->image_pane().zoom(zoom);
+    viewer->render_frame();
+    // Drag from image (120, 90) to (180, 150) in display coordinates.
+    const cv::Point2d a = viewer->image_pane().image_to_display({120, 90});
+    const cv::Point2d b = viewer->image_pane().image_to_display({180, 150});
+    for (const auto& p : {cv::Point2d(120, 90), cv::Point2d(180, 150), cv::Point2d(160.5, 119.25)}) {
+      const auto back = viewer->image_pane().display_to_image(viewer->image_pane().image_to_display(p).x,
+                                                              viewer->image_pane().image_to_display(p).y);
+      ASSERT_TRUE(back.has_value());
+      EXPECT_NEAR(back->x, p.x, 1e-6);
+      EXPECT_NEAR(back->y, p.y, 1e-6);
+    }
+    viewer->begin_selection(a.x, a.y);
+    viewer->drag_selection((a.x + b.x) / 2, (a.y + b.y) / 2);
+    const auto box = viewer->end_selection(b.x, b.y);
+    ASSERT_TRUE(box.has_value()) << w << "x" << h << " zoom " << zoom;
+    EXPECT_NEAR(box->x, 120, 1e-6);
+    EXPECT_NEAR(box->y, 90, 1e-6);
+    EXPECT_NEAR(box->width, 60, 1e-6);
+    EXPECT_NEAR(box->height, 60, 1e-6);
+    // The viewer's own bus delivers the TRACK_CMD it sent (handled in its LCM thread).
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    viewer->stop();
+    ASSERT_EQ(cmds.size(), 1u);
+    EXPECT_EQ(cmds[0].command, aerie::track_cmd_t::INIT);
+    EXPECT_EQ(cmds[0].tracker, viewer->current_tracker());
+    EXPECT_NEAR(cmds[0].x, 120, 1e-6);
+  }
+}
+
+TEST_F(Fixture, OctomapVoxelsAppearWhereTheMapHasThem) {
+  make();
+  octomap::OcTree tree(0.2);
+  int expected = 0;
+  for (int i = 0; i < 5; ++i)  // voxel centres, so no two points share a voxel
+    for (int j = 0; j < 5; ++j) {
+      tree.updateNode(octomap::point3d(2.1f + 0.2f * i, -0.5f + 0.2f * j, 1.1f), true);
+      ++expected;
+    }
+  std::ostringstream out;
+  tree.writeBinary(out);
+  const std::string bytes = out.str();
+  aerie::octomap_t m{};
+  m.utime = 5;
+  m.resolution = 0.2;
+  m.binary = true;
+  m.full = true;
+  m.data.assign(bytes.begin(), bytes.end());
+  m.length = static_cast<int32_t>(m.data.size());
+  bus.publish("MAP_OCTOMAP", m);
+  auto* oct = dynamic_cast<OctomapRenderer*>(viewer->find("octomap"));
+  ASSERT_NE(oct, nullptr);
+  ASSERT_TRUE(render_until([&] { return oct->voxels_shown() > 0; }));
+  EXPECT_EQ(oct->voxels_shown(), static_cast<size_t>(expected));
+  // Look at the voxels and find coloured (not background, not grid-gray) pixels there.
+  auto* scene = viewer->layout().scene.Get();
+  scene->ResetCamera();
+  const cv::Mat img = snapshot();
+  scene->SetWorldPoint(2.5, -0.1, 1.1, 1.0);
+  scene->WorldToDisplay();
+  double d[3];
+  scene->GetDisplayPoint(d);
+  const cv::Point p(cvRound(d[0]), img.rows - 1 - cvRound(d[1]));
+  const cv::Vec3b c = img.at<cv::Vec3b>(p);
+  const int spread = std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]});
+  EXPECT_GT(spread, 60) << "expected a height-coloured voxel at " << p << ", got " << cv::Mat(c).t();
+  // Coarser display resolution: fewer (merged) voxels.
+  oct->set_coarsening(2);
+  viewer->render_frame();
+  EXPECT_LT(oct->voxels_shown(), static_cast<size_t>(expected));
+  EXPECT_GT(oct->voxels_shown(), 0u);
+}
+
+TEST_F(Fixture, ChartsDrawTheirLines) {
+  make();
+  for (int i = 0; i < 50; ++i) {
+    aerie::control_cmd_t c{};
+    c.utime = 1000000 + i * 50000;
+    c.seq = i;
+    c.heading_deg = static_cast<float>(i);
+    c.heading_ref_deg = 90;
+    bus.publish("CTRL_CMD", c);
+  }
+  auto* chart = dynamic_cast<ChartRenderer*>(viewer->find("chart-heading"));
+  ASSERT_NE(chart, nullptr);
+  ASSERT_TRUE(render_until([&] { return chart->samples_shown() == 50; }));
+  const cv::Mat img = snapshot();
+  // The heading line colour (BGR 20, 80, 230) appears inside the heading chart's viewport.
+  double vp[4];
+  viewer->layout().chart(ChartSlot::Heading)->GetViewport(vp);
+  const cv::Rect roi(cvRound(vp[0] * img.cols), cvRound((1 - vp[3]) * img.rows), cvRound((vp[2] - vp[0]) * img.cols),
+                     cvRound((vp[3] - vp[1]) * img.rows));
+  cv::Mat mask;
+  cv::inRange(img(roi), cv::Scalar(0, 50, 190), cv::Scalar(60, 120, 255), mask);
+  EXPECT_GT(cv::countNonZero(mask), 40);
+}
+
+TEST_F(Fixture, SurvivesMalformedMessagesAndChannelsThatStopAndRestart) {
+  make();
+  const uint8_t junk[5] = {9, 9, 9, 9, 9};
+  for (const char* ch : {"CAM_LEFT", "TRACK", "MAP_OCTOMAP", "VO_DEPTH", "CTRL_CMD", "STATUS_X"})
+    bus.raw().publish(ch, junk, sizeof(junk));
+  aerie::octomap_t bad{};
+  bad.resolution = 0.1;
+  bad.binary = true;
+  bad.data = {1, 2, 3};
+  bad.length = 3;
+  bus.publish("MAP_OCTOMAP", bad);  // decodes, but is no OctoMap
+  auto wrong = image::to_message(cv::Mat(240, 320, CV_8UC1, cv::Scalar(1)), 1, 1);
+  wrong.height = 999;  // payload too short for that
+  bus.publish("CAM_LEFT", wrong);
+  render_until([] { return false; });
+  EXPECT_TRUE(viewer->image_pane().image_size().empty());
+  // A valid stream afterwards is shown; it stops, and starts again with new content.
+  publish_image(10, 50);
+  ASSERT_TRUE(render_until([&] { return viewer->image_pane().image_size() == cv::Size(320, 240); }));
+  render_until([] { return false; });
+  const cv::Point centre = window_pixel_of_image({160, 120});
+  EXPECT_TRUE(near_color(snapshot(), centre, {50, 50, 50}, 0, 8));
+  publish_image(5000000, 200);
+  render_until([] { return false; });
+  EXPECT_TRUE(near_color(snapshot(), centre, {200, 200, 200}, 0, 8));
+  int64_t malformed = 0;
+  for (const auto& s : bus.subscriptions()) malformed += s->counters().malformed + s->counters().handler_errors;
+  EXPECT_GE(malformed, 8);
+}
+
+TEST_F(Fixture, ProcmanPanelShowsDeputyCommandsAndStartsOrStopsTheSelectedOne) {
+  make();
+  bot_procman::info2_t info{};
+  info.utime = util::wall_utime();
+  info.host = "air";
+  info.cpu_load = 0.25f;
+  info.phys_mem_total_bytes = 8LL << 30;
+  info.phys_mem_free_bytes = 4LL << 30;
+  for (auto [name, pid, runid] : {std::tuple{"capture", 4242, 1}, std::tuple{"vo", 0, 0}}) {
+    bot_procman::deputy_cmd2_t c{};
+    c.cmd.command_name = name;
+    c.cmd.exec_str = std::string("aerie-") + name;
+    c.cmd.num_options = 0;
+    c.pid = pid;
+    c.actual_runid = runid;
+    c.sheriff_id = pid ? 1 : 2;
+    c.cpu_usage = 0.5f;
+    c.mem_rss_bytes = 64LL << 20;
+    info.cmds.push_back(c);
+  }
+  info.ncmds = 2;
+  info.num_options = 0;
+  std::vector<bot_procman::orders2_t> orders;
+  bus.subscribe<bot_procman::orders2_t>("PMD_ORDERS2", [&](const bot_procman::orders2_t& o, const bus::ReceiveInfo&) {
+    orders.push_back(o);
+  });
+  bus.publish("PMD_INFO2", info);
+  auto* panel = dynamic_cast<ProcmanPanel*>(viewer->find("processes"));
+  ASSERT_NE(panel, nullptr);
+  ASSERT_TRUE(render_until([&] { return panel->text().find("capture") != std::string::npos; }));
+  const std::string text = panel->text();
+  EXPECT_NE(text.find("host air"), std::string::npos) << text;
+  EXPECT_NE(text.find("capture          running"), std::string::npos) << text;
+  EXPECT_NE(text.find("vo"), std::string::npos) << text;
+
+  // Stop the running command (selected first), then start the stopped one.
+  auto stop = ProcmanPanel::orders_for(info, 1, false, 5, "v");
+  ASSERT_EQ(stop.ncmds, 2);
+  EXPECT_EQ(stop.cmds[0].force_quit, 1);
+  EXPECT_EQ(stop.cmds[1].force_quit, 0);
+  EXPECT_EQ(stop.cmds[1].desired_runid, 0);  // untouched: stays stopped
+  auto start = ProcmanPanel::orders_for(info, 2, true, 5, "v");
+  EXPECT_EQ(start.cmds[0].desired_runid, 1);  // untouched: keeps running
+  EXPECT_EQ(start.cmds[1].desired_runid, 1);  // a new run
+  EXPECT_EQ(start.cmds[1].force_quit, 0);
+
+  viewer->on_key("s");  // the selected command is "capture", running: stop it
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  viewer->stop();
+  ASSERT_EQ(orders.size(), 1u);
+  EXPECT_EQ(orders[0].host, "air");
+  ASSERT_EQ(orders[0].ncmds, 2);
+  EXPECT_EQ(orders[0].cmds[0].force_quit, 1);
+}

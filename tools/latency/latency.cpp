@@ -1,0 +1,190 @@
+#include "tools/latency/latency.hpp"
+
+#include <aerie/process_status_t.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "common/bus/bus.hpp"
+#include "tools/log/type_registry.hpp"
+
+namespace aerie::latency {
+namespace {
+
+constexpr double kDayMs = 86'400'000.0;
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string json_summary(const Summary& s) {
+  char b[256];
+  std::snprintf(b, sizeof b,
+                "{\"count\": %lld, \"min\": %.3f, \"mean\": %.3f, \"median\": %.3f, \"p90\": %.3f, \"p99\": %.3f, "
+                "\"max\": %.3f}",
+                static_cast<long long>(s.count), s.min, s.mean, s.median, s.p90, s.p99, s.max);
+  return b;
+}
+
+std::string csv_row(const std::string& kind, const std::string& name, const std::string& type, const Summary& s,
+                    int64_t unstamped = 0, int64_t other_clock = 0, int64_t negative = 0) {
+  char b[512];
+  std::snprintf(b, sizeof b, "%s,%s,%s,%lld,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%lld,%lld,%lld\n", kind.c_str(), name.c_str(),
+                type.c_str(), static_cast<long long>(s.count), s.min, s.mean, s.median, s.p90, s.p99, s.max,
+                static_cast<long long>(unstamped), static_cast<long long>(other_clock),
+                static_cast<long long>(negative));
+  return b;
+}
+
+}  // namespace
+
+LatencyAnalysis::LatencyAnalysis(Options options)
+    : options_(std::move(options)), channel_re_(options_.channels, std::regex::extended) {}
+
+void LatencyAnalysis::add(const std::string& channel, int64_t log_utime, const uint8_t* data, size_t size) {
+  ++events_;
+  const int64_t fp = logtools::fingerprint_of(data, size);
+  // Per hop, from the nodes' heartbeats (whatever the channel filter).
+  if (channel.rfind("STATUS_", 0) == 0 && fp == aerie::process_status_t::getHash()) {
+    aerie::process_status_t st;
+    if (st.decode(data, 0, static_cast<int>(size)) >= 0 && st.last_source_utime > 0 && st.last_receive_utime > 0 &&
+        st.last_publish_utime > 0) {
+      HopAcc& h = hops_[st.node.empty() ? channel.substr(7) : st.node];
+      // A heartbeat of an idle node repeats its last hop: count each hop once.
+      if (st.last_source_utime != h.last_source || st.last_receive_utime != h.last_receive ||
+          st.last_publish_utime != h.last_publish) {
+        h.input.push_back(static_cast<double>(st.last_receive_utime - st.last_source_utime) / 1000.0);
+        h.processing.push_back(static_cast<double>(st.last_publish_utime - st.last_receive_utime) / 1000.0);
+        h.age.push_back(static_cast<double>(st.last_publish_utime - st.last_source_utime) / 1000.0);
+        h.last_source = st.last_source_utime;
+        h.last_receive = st.last_receive_utime;
+        h.last_publish = st.last_publish_utime;
+      }
+    }
+  }
+  auto [it, fresh] = matches_.try_emplace(channel, false);
+  if (fresh) it->second = std::regex_match(channel, channel_re_);
+  if (!it->second) return;
+  Acc& a = channels_[channel];
+  ++a.messages;
+  const logtools::TypeInfo* type = logtools::find_type(fp);
+  if (type) a.type = type->name;
+  const auto utime = bus::peek_utime(data, size);
+  if ((!type && !options_.unknown_types) || !utime) {
+    ++a.unstamped;
+    return;
+  }
+  const double ms = static_cast<double>(log_utime - *utime) / 1000.0;
+  if (std::fabs(ms) > kDayMs) {
+    ++a.other_clock;
+    return;
+  }
+  if (ms < 0) ++a.negative;
+  a.ms.push_back(ms);
+}
+
+std::vector<ChannelLatency> LatencyAnalysis::channels() const {
+  std::vector<ChannelLatency> out;
+  for (const auto& [name, a] : channels_) {
+    ChannelLatency c;
+    c.channel = name;
+    c.type = a.type;
+    c.latency_ms = summarize(a.ms);
+    c.messages = a.messages;
+    c.unstamped = a.unstamped;
+    c.other_clock = a.other_clock;
+    c.negative = a.negative;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::vector<HopLatency> LatencyAnalysis::hops() const {
+  std::vector<HopLatency> out;
+  for (const auto& [node, h] : hops_)
+    out.push_back({node, summarize(h.input), summarize(h.processing), summarize(h.age)});
+  return out;
+}
+
+std::string format_table(const std::vector<ChannelLatency>& channels, const std::vector<HopLatency>& hops) {
+  std::ostringstream os;
+  char b[512];
+  os << "End-to-end latency per channel: log receive time - message utime (ms)\n";
+  std::snprintf(b, sizeof b, "%-22s %-28s %8s %9s %9s %9s %9s  %s\n", "CHANNEL", "TYPE", "N", "MEDIAN", "P90", "P99",
+                "MAX", "NOTES");
+  os << b;
+  for (const auto& c : channels) {
+    std::string notes;
+    if (c.unstamped) notes += std::to_string(c.unstamped) + " without utime; ";
+    if (c.other_clock) notes += std::to_string(c.other_clock) + " stamped by another clock (dataset time?); ";
+    if (c.negative) notes += std::to_string(c.negative) + " negative: clocks differ; ";
+    const auto& s = c.latency_ms;
+    if (s.count > 0)
+      std::snprintf(b, sizeof b, "%-22s %-28s %8lld %9.2f %9.2f %9.2f %9.2f  %s\n", c.channel.c_str(),
+                    c.type.empty() ? "?" : c.type.c_str(), static_cast<long long>(s.count), s.median, s.p90, s.p99,
+                    s.max, notes.c_str());
+    else
+      std::snprintf(b, sizeof b, "%-22s %-28s %8d %9s %9s %9s %9s  %s\n", c.channel.c_str(),
+                    c.type.empty() ? "?" : c.type.c_str(), 0, "-", "-", "-", "-", notes.c_str());
+    os << b;
+  }
+  if (!hops.empty()) {
+    os << "\nPer hop, from the nodes' STATUS_* heartbeats (ms): input = receive - source utime,\n"
+          "processing = publish - receive, age = publish - source utime\n";
+    std::snprintf(b, sizeof b, "%-16s %6s  %-26s  %-26s  %-26s\n", "NODE", "N", "INPUT median/p90/max",
+                  "PROCESSING median/p90/max", "AGE median/p90/max");
+    os << b;
+    auto three = [](const Summary& s) {
+      char t[64];
+      std::snprintf(t, sizeof t, "%8.2f %8.2f %8.2f", s.median, s.p90, s.max);
+      return std::string(t);
+    };
+    for (const auto& h : hops) {
+      std::snprintf(b, sizeof b, "%-16s %6lld  %-26s  %-26s  %-26s\n", h.node.c_str(),
+                    static_cast<long long>(h.input_ms.count), three(h.input_ms).c_str(),
+                    three(h.processing_ms).c_str(), three(h.age_ms).c_str());
+      os << b;
+    }
+  }
+  return os.str();
+}
+
+std::string to_csv(const std::vector<ChannelLatency>& channels, const std::vector<HopLatency>& hops) {
+  std::string out = "kind,name,type,count,min_ms,mean_ms,median_ms,p90_ms,p99_ms,max_ms,unstamped,other_clock,negative\n";
+  for (const auto& c : channels)
+    out += csv_row("channel", c.channel, c.type, c.latency_ms, c.unstamped, c.other_clock, c.negative);
+  for (const auto& h : hops) {
+    out += csv_row("hop_input", h.node, "", h.input_ms);
+    out += csv_row("hop_processing", h.node, "", h.processing_ms);
+    out += csv_row("hop_age", h.node, "", h.age_ms);
+  }
+  return out;
+}
+
+std::string to_json(const std::vector<ChannelLatency>& channels, const std::vector<HopLatency>& hops) {
+  std::ostringstream os;
+  os << "{\n  \"channels\": [";
+  for (size_t i = 0; i < channels.size(); ++i) {
+    const auto& c = channels[i];
+    os << (i ? "," : "") << "\n    {\"channel\": " << json_string(c.channel) << ", \"type\": " << json_string(c.type)
+       << ", \"messages\": " << c.messages << ", \"unstamped\": " << c.unstamped
+       << ", \"other_clock\": " << c.other_clock << ", \"negative\": " << c.negative
+       << ", \"latency_ms\": " << json_summary(c.latency_ms) << "}";
+  }
+  os << "\n  ],\n  \"hops\": [";
+  for (size_t i = 0; i < hops.size(); ++i) {
+    const auto& h = hops[i];
+    os << (i ? "," : "") << "\n    {\"node\": " << json_string(h.node) << ", \"input_ms\": " << json_summary(h.input_ms)
+       << ", \"processing_ms\": " << json_summary(h.processing_ms) << ", \"age_ms\": " << json_summary(h.age_ms) << "}";
+  }
+  os << "\n  ]\n}\n";
+  return os.str();
+}
+
+}  // namespace aerie::latency

@@ -1,0 +1,49 @@
+// aerie-latency: end-to-end latency per channel (log receive time - message utime)
+// and per hop (from the nodes' STATUS_* heartbeats) of any LCM log.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <iostream>
+
+#include "common/logio/event_log.hpp"
+#include "common/util/cli.hpp"
+#include "tools/latency/latency.hpp"
+
+int main(int argc, char** argv) {
+  using namespace aerie;
+  CLI::App app{
+      "aerie-latency: end-to-end latency of every channel of an LCM log (receive time in the log minus\n"
+      "the message's source utime) as median/p90/p99/max, and per hop from the nodes' STATUS_* messages."};
+  std::string log_path, csv, json, log_level = "info";
+  latency::LatencyAnalysis::Options opts;
+  app.add_option("log", log_path, "LCM log file (lcm-logger)")->required()->check(CLI::ExistingFile);
+  app.add_option("--channels", opts.channels, "regex of the channels to report (whole names)")->capture_default_str();
+  app.add_flag("--unknown-types", opts.unknown_types,
+               "also read utime from payloads of types outside Aerie's catalogue (assumes utime comes first)");
+  app.add_option("--csv", csv, "write the figures as CSV");
+  app.add_option("--json", json, "write the figures as JSON");
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
+  CLI11_PARSE(app, argc, argv);
+  util::init_logging("aerie-latency", log_level);
+  try {
+    latency::LatencyAnalysis analysis(opts);
+    logio::Reader reader(log_path, logio::Reader::Options{.resync = true});
+    logio::Event ev;
+    while (reader.next(ev)) analysis.add(ev.channel, ev.utime, ev.data.data(), ev.data.size());
+    for (const auto& d : reader.damage()) spdlog::warn("{}", d.message);
+    const auto channels = analysis.channels();
+    const auto hops = analysis.hops();
+    std::cout << log_path << ": " << analysis.events() << " events\n\n" << latency::format_table(channels, hops);
+    auto write = [](const std::string& path, const std::string& text) {
+      std::ofstream out(path);
+      if (!(out << text)) throw std::runtime_error("cannot write '" + path + "'");
+    };
+    if (!csv.empty()) write(csv, latency::to_csv(channels, hops));
+    if (!json.empty()) write(json, latency::to_json(channels, hops));
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 1;
+  }
+  return 0;
+}

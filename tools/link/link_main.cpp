@@ -1,0 +1,268 @@
+// aerie-link: the air-ground radio link in user space. Relays LCM channels between
+// the air network and the ground network (one regex per direction) with delay,
+// jitter, loss, a bandwidth cap with a bounded queue, optional reordering and
+// optional JPEG re-encoding of images; publishes LINK_STATS once a second.
+#include <aerie/link_stats_t.hpp>
+#include <poll.h>
+#include <sched.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <regex>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/bus/bus.hpp"
+#include "common/bus/node.hpp"
+#include "common/util/cli.hpp"
+#include "common/util/time.hpp"
+#include "tools/link/link_config.hpp"
+#include "tools/link/link_model.hpp"
+#include "tools/latency/stats.hpp"
+#include "tools/link/reencode.hpp"
+
+namespace {
+
+using namespace aerie;
+
+int64_t mono_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// LCM channel regexes match whole names (LCM anchors them with ^...$).
+class ChannelMatcher {
+ public:
+  explicit ChannelMatcher(const std::string& regex)
+      : re_(regex.empty() ? std::regex("$^") : std::regex(regex, std::regex::extended)) {}
+  bool operator()(const std::string& channel) {
+    const auto it = cache_.find(channel);
+    if (it != cache_.end()) return it->second;
+    return cache_[channel] = std::regex_match(channel, re_);
+  }
+
+ private:
+  std::regex re_;
+  std::unordered_map<std::string, bool> cache_;
+};
+
+// What the relay published on a network comes back to its own subscriptions
+// there (multicast loopback): remember it briefly and drop the echo.
+class EchoFilter {
+ public:
+  static uint64_t key(const std::string& channel, const uint8_t* data, size_t size) {
+    const uint64_t h1 = std::hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(data), size));
+    return h1 ^ (std::hash<std::string>{}(channel) * 0x9E3779B97F4A7C15ULL);
+  }
+  void sent(uint64_t k, int64_t now_us) {
+    keys_.insert(k);
+    order_.emplace_back(now_us, k);
+    while (!order_.empty() && now_us - order_.front().first > 5'000'000) {
+      if (auto it = keys_.find(order_.front().second); it != keys_.end()) keys_.erase(it);
+      order_.pop_front();
+    }
+  }
+  bool is_echo(uint64_t k) {
+    const auto it = keys_.find(k);
+    if (it == keys_.end()) return false;
+    keys_.erase(it);
+    return true;
+  }
+
+ private:
+  std::unordered_multiset<uint64_t> keys_;
+  std::deque<std::pair<int64_t, uint64_t>> order_;
+};
+
+struct Side {
+  std::string name;
+  std::unique_ptr<bus::Bus> bus;
+  EchoFilter echo;
+};
+
+struct Route {
+  link::LinkDirection model;
+  Side* from;
+  Side* to;
+  ChannelMatcher jpeg;
+  ChannelMatcher reverse;    // the other direction's channels: only those can echo back
+  std::vector<double> delays_ms;  // achieved over the stats period
+  int64_t bytes_at_period_start = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "aerie-link: emulates the air-ground radio link between two LCM networks (delay, jitter,\n"
+      "loss, bandwidth cap, reordering, JPEG re-encoding); publishes LINK_STATS. See docs/link.md."};
+  util::CommonOptions common;
+  std::string air_url, ground_url;
+  std::optional<uint64_t> seed;
+  std::optional<double> delay_ms, jitter_ms, loss, bandwidth_kbps;
+  app.add_option("-c,--config", common.config, "YAML configuration (config/link.yaml)")->check(CLI::ExistingFile);
+  app.add_option("--air-url", air_url, "LCM URL of the air network (overrides the config)");
+  app.add_option("--ground-url", ground_url, "LCM URL of the ground network (overrides the config)");
+  app.add_option("--seed", seed, "random seed (both directions; overrides the config)");
+  app.add_option("--delay-ms", delay_ms, "propagation delay, both directions");
+  app.add_option("--jitter-ms", jitter_ms, "jitter (standard deviation), both directions");
+  app.add_option("--loss", loss, "Bernoulli loss probability, both directions");
+  app.add_option("--bandwidth-kbps", bandwidth_kbps, "bandwidth cap in kbit/s, both directions (0 = none)");
+  int rt_priority = 0;
+  app.add_option("--realtime-priority", rt_priority,
+                 "run under SCHED_FIFO at this priority (1..99; needs root or CAP_SYS_NICE) so that a busy\n"
+                 "host does not add scheduling delay; 0 = normal scheduling")
+      ->check(CLI::Range(0, 99));
+  app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, critical or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  CLI11_PARSE(app, argc, argv);
+  util::init_logging("aerie-link", common.log_level);
+
+  try {
+    link::LinkConfig cfg = link::load_link_config(common.config.empty() ? util::Config() : util::Config::load(common.config));
+    if (!air_url.empty()) cfg.air_url = air_url;
+    if (!ground_url.empty()) cfg.ground_url = ground_url;
+    if (cfg.air_url == cfg.ground_url)
+      throw std::invalid_argument("the air and ground URLs are the same (" + cfg.air_url + ")");
+    for (auto* d : {&cfg.air_to_ground, &cfg.ground_to_air}) {
+      if (seed) d->seed = d == &cfg.air_to_ground ? 2 * *seed - 1 : 2 * *seed;
+      if (delay_ms) d->delay_ms = *delay_ms;
+      if (jitter_ms) d->jitter_ms = *jitter_ms;
+      if (loss) {
+        d->loss_model = link::LossModel::Bernoulli;
+        d->loss = *loss;
+      }
+      if (bandwidth_kbps) d->bandwidth_bps = *bandwidth_kbps * 1000.0;
+    }
+
+    if (rt_priority > 0) {
+      // Before the LCM threads start: they inherit the policy.
+      sched_param sp{};
+      sp.sched_priority = rt_priority;
+      if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+        spdlog::warn("cannot use SCHED_FIFO priority {}: {} (running with normal scheduling)", rt_priority,
+                     std::strerror(errno));
+    }
+    Side air{"air", std::make_unique<bus::Bus>(cfg.air_url), {}};
+    Side ground{"ground", std::make_unique<bus::Bus>(cfg.ground_url), {}};
+    std::vector<std::unique_ptr<Route>> routes;
+    routes.push_back(std::make_unique<Route>(Route{link::LinkDirection(cfg.air_to_ground), &air, &ground,
+                                                   ChannelMatcher(cfg.air_to_ground.jpeg_channels),
+                                                   ChannelMatcher(cfg.ground_to_air.channels), {}, 0}));
+    routes.push_back(std::make_unique<Route>(Route{link::LinkDirection(cfg.ground_to_air), &ground, &air,
+                                                   ChannelMatcher(cfg.ground_to_air.jpeg_channels),
+                                                   ChannelMatcher(cfg.air_to_ground.channels), {}, 0}));
+    for (auto& rp : routes) {
+      Route& r = *rp;
+      r.from->bus->subscribe_raw(r.model.config().channels, [&r, &cfg](const uint8_t* data, size_t size,
+                                                                       const bus::ReceiveInfo& info) {
+        if (info.channel == cfg.stats_channel) return;
+        if (r.from->echo.is_echo(EchoFilter::key(info.channel, data, size))) return;
+        link::Packet p;
+        p.channel = info.channel;
+        p.data.assign(data, data + size);
+        p.recv_wall_utime = info.recv_utime;
+        if (r.jpeg(info.channel)) {
+          if (auto smaller = link::reencode_jpeg(p.data, r.model.config().jpeg_quality)) {
+            p.data = std::move(*smaller);
+            ++r.model.counters().reencoded;
+          }
+        }
+        r.model.offer(std::move(p), mono_us());
+      }, 10000);
+    }
+
+    spdlog::info("air {} <-> ground {}", cfg.air_url, cfg.ground_url);
+    for (const auto& r : routes) {
+      const auto& d = r->model.config();
+      spdlog::info("{}: channels '{}', delay {} ms, jitter {} ms ({}), loss {}, bandwidth {}, queue {} B, seed {}",
+                   d.name, d.channels, d.delay_ms, d.jitter_ms, link::to_string(d.jitter),
+                   d.loss_model == link::LossModel::Bernoulli ? std::to_string(d.loss)
+                                                              : "GE mean " + std::to_string(d.gilbert_elliott.mean_loss()),
+                   d.bandwidth_bps > 0 ? std::to_string(d.bandwidth_bps / 1000.0) + " kbit/s" : "unlimited",
+                   d.queue_bytes, d.seed);
+    }
+
+    bus::install_stop_handlers();
+    const int64_t period_us = static_cast<int64_t>(cfg.stats_period_s * 1e6);
+    int64_t next_stats = mono_us() + period_us;
+    int64_t stats_seq = 0;
+    while (!bus::stop_requested()) {
+      int64_t now = mono_us();
+      int64_t wake = next_stats;
+      for (const auto& r : routes)
+        if (const int64_t t = r->model.next_event_us(); t >= 0) wake = std::min(wake, t);
+      pollfd fds[2] = {{air.bus->fileno(), POLLIN, 0}, {ground.bus->fileno(), POLLIN, 0}};
+      const int64_t wait_us = std::max<int64_t>(0, wake - now);
+      const timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
+      ppoll(fds, 2, &ts, nullptr);
+      for (int k = 0; k < 2; ++k) {
+        if (!(fds[k].revents & POLLIN)) continue;
+        bus::Bus& b = k == 0 ? *air.bus : *ground.bus;
+        for (int n = 0; n < 1000 && b.handle(0) > 0; ++n) {
+        }
+      }
+      now = mono_us();
+      for (auto& rp : routes) {
+        Route& r = *rp;
+        for (auto& p : r.model.due(now)) {
+          const uint64_t k = EchoFilter::key(p.channel, p.data.data(), p.data.size());
+          if (r.reverse(p.channel)) r.to->echo.sent(k, now);
+          r.to->bus->raw().publish(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
+          r.delays_ms.push_back(static_cast<double>(util::wall_utime() - p.recv_wall_utime) / 1000.0);
+        }
+      }
+      if (now >= next_stats) {
+        aerie::link_stats_t s;
+        s.utime = util::wall_utime();
+        s.seq = stats_seq++;
+        s.period_s = cfg.stats_period_s;
+        for (auto& rp : routes) {
+          Route& r = *rp;
+          const auto& c = r.model.counters();
+          aerie::link_direction_stats_t d;
+          d.name = r.model.config().name;
+          d.received = c.received;
+          d.delivered = c.delivered;
+          d.bytes_delivered = c.bytes_delivered;
+          d.dropped_loss = c.dropped_loss;
+          d.dropped_queue = c.dropped_queue;
+          d.dropped_other = c.dropped_other;
+          d.reencoded = c.reencoded;
+          d.queue_depth = r.model.queue_depth();
+          d.queue_bytes = r.model.queue_bytes();
+          const auto delay = latency::summarize(std::move(r.delays_ms));
+          d.delay_p50_ms = delay.median;
+          d.delay_p90_ms = delay.p90;
+          d.delay_p99_ms = delay.p99;
+          d.delay_max_ms = delay.max;
+          d.throughput_bps = static_cast<double>(c.bytes_delivered - r.bytes_at_period_start) * 8.0 / cfg.stats_period_s;
+          r.bytes_at_period_start = c.bytes_delivered;
+          r.delays_ms.clear();
+          s.directions.push_back(std::move(d));
+        }
+        s.ndirections = static_cast<int32_t>(s.directions.size());
+        if (cfg.stats_on_air) air.bus->publish(cfg.stats_channel, s);
+        if (cfg.stats_on_ground) ground.bus->publish(cfg.stats_channel, s);
+        next_stats += period_us;
+        if (next_stats < now) next_stats = now + period_us;
+      }
+    }
+    for (const auto& r : routes) {
+      const auto& c = r->model.counters();
+      spdlog::info("{}: received {}, delivered {}, lost {}, queue drops {}, other drops {}, re-encoded {}, {} waiting",
+                   r->model.config().name, c.received, c.delivered, c.dropped_loss, c.dropped_queue, c.dropped_other,
+                   c.reencoded, r->model.queue_depth() + r->model.in_flight());
+    }
+  } catch (const std::exception& e) {
+    spdlog::critical("{}", e.what());
+    return 1;
+  }
+  return 0;
+}
