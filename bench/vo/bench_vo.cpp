@@ -30,11 +30,12 @@ struct Source {
   stereo::StereoCamera cam;
   std::shared_ptr<eval::Trajectory> gt = std::make_shared<eval::Trajectory>();  // sim: filled as frames come
   std::function<bool(size_t, cv::Mat&, cv::Mat&, int64_t&)> next;
+  std::shared_ptr<cv::Mat> exact = std::make_shared<cv::Mat>();  // sim: the exact disparity of the last frame
   size_t frames = 0;
   double path_m = 0;  // ground-truth path length known in advance (sim), else 0
 };
 
-Source open_dataset(const std::string& spec) {
+Source open_dataset(const std::string& spec, bool exact_depth) {
   Source s;
   const auto colon = spec.find(':');
   const std::string kind = spec.substr(0, colon), arg = colon == std::string::npos ? "" : spec.substr(colon + 1);
@@ -48,6 +49,7 @@ Source open_dataset(const std::string& spec) {
     rig.noise_sigma = cfg.get<double>("rig.noise_sigma", 1.0);
     rig.pitch_deg = cfg.get<double>("rig.pitch_deg", rig.pitch_deg);
     rig.illumination_amplitude = cfg.get<double>("rig.illumination_amplitude", rig.illumination_amplitude);
+    rig.disparity = exact_depth;
     const std::string traj = cfg.get<std::string>("trajectory.kind", "survey_loops");
     const double speed = cfg.get<double>("trajectory.speed", 1.0);
     const double rate = cfg.get<double>("rate_hz", 20.0);
@@ -62,13 +64,17 @@ Source open_dataset(const std::string& spec) {
     s.frames = static_cast<size_t>(simulation->frame_count());
     s.path_m = t.length();
     s.name = "sim " + traj + " " + std::to_string(rig.width) + "x" + std::to_string(rig.height);
-    s.next = [simulation, gt = s.gt](size_t, cv::Mat& l, cv::Mat& r, int64_t& utime) {
+    s.next = [simulation, gt = s.gt, exact = s.exact](size_t, cv::Mat& l, cv::Mat& r, int64_t& utime) {
       sim::StereoFrame f;
       if (!simulation->next(f)) return false;
       l = f.left;
       r = f.right;
       utime = f.utime;
       gt->push_back(static_cast<double>(f.utime) * 1e-6, f.T_world_left);
+      if (!f.disparity.empty()) {
+        *exact = f.disparity;
+        exact->setTo(-1.0f, f.disparity != f.disparity);  // NaN: nothing hit
+      }
       return true;
     };
     return s;
@@ -105,7 +111,7 @@ int main(int argc, char** argv) {
   std::string dataset, config, out = "vo_trajectory.txt", json_path, plot;
   size_t max_frames = 0;
   double rpe_delta_m = 0;
-  bool ba_sync = true;
+  bool ba_sync = true, exact_depth = false;
   app.add_option("--dataset", dataset, "kitti:DIR, euroc:DIR or sim:CONFIG.yaml")->required();
   app.add_option("-c,--config", config, "VO configuration (config/vo.yaml format)")->check(CLI::ExistingFile);
   app.add_option("--out", out, "trajectory output (TUM: t x y z qx qy qz qw)");
@@ -114,12 +120,15 @@ int main(int argc, char** argv) {
   app.add_option("--max-frames", max_frames, "stop after this many frames (0 = all)");
   app.add_option("--rpe-delta-m", rpe_delta_m, "also RPE over path segments of this length (m)");
   app.add_option("--ba-sync", ba_sync, "wait for each bundle adjustment (reproducible figures; false = as flown)");
+  app.add_flag("--exact-depth", exact_depth, "sim only: use the renderer's exact disparity instead of SGBM_F "
+                                          "(separates depth errors from tracking errors)");
   CLI11_PARSE(app, argc, argv);
   try {
     stereo::VoParams params =
         config.empty() ? stereo::VoParams{} : stereo::vo_params_from_config(util::Config::load(config), {"node"});
     params.ba_synchronous = ba_sync;
-    Source src = open_dataset(dataset);
+    Source src = open_dataset(dataset, exact_depth);
+    if (exact_depth && dataset.rfind("sim:", 0) != 0) throw std::runtime_error("--exact-depth needs a sim: dataset");
     stereo::StereoOdometry vo(src.cam, params);
     std::cout << src.name << ": " << src.frames << " frames " << src.cam.width << "x" << src.cam.height
               << ", f " << src.cam.fx << " px, baseline " << src.cam.baseline << " m, SGM SIMD "
@@ -133,7 +142,8 @@ int main(int argc, char** argv) {
     cv::Mat l, r;
     for (size_t i = 0; (max_frames == 0 || i < max_frames) && src.next(i, l, r, utime); ++i) {
       util::Stopwatch sw;
-      const stereo::VoResult res = vo.process(l, r, utime);
+      const stereo::VoResult res = exact_depth ? vo.process_with_disparity(l, r, utime, *src.exact)
+                                               : vo.process(l, r, utime);
       wall.add(sw.ms());
       est.push_back(static_cast<double>(utime) * 1e-6, res.T_world_cam);
       const auto& t = res.timings;

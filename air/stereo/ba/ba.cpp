@@ -61,7 +61,7 @@ struct Reprojection {
 void BaParams::validate(const std::string& what) const {
   if (window < 2) throw std::invalid_argument(what + ".window: at least 2 keyframes");
   if (max_iterations < 1) throw std::invalid_argument(what + ".max_iterations: >= 1");
-  if (!(huber_px > 0)) throw std::invalid_argument(what + ".huber_px: > 0");
+  if (!(huber_px > 0) || !(outlier_px > 0)) throw std::invalid_argument(what + ".huber_px/outlier_px: > 0");
   if (min_observations < 2) throw std::invalid_argument(what + ".min_observations: >= 2");
   if (!(max_depth_m > 0)) throw std::invalid_argument(what + ".max_depth_m: > 0");
 }
@@ -90,7 +90,9 @@ BaResult bundle_adjust(const std::vector<Keyframe>& window, const std::vector<ge
 
   ceres::Problem::Options popts;
   popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  popts.enable_fast_removal = true;
   ceres::Problem problem(popts);
+  std::vector<ceres::ResidualBlockId> blocks;
   ceres::HuberLoss loss(params.huber_px);
   for (auto& [id, seen] : tracks) {
     if (static_cast<int>(seen.obs.size()) < params.min_observations) continue;
@@ -115,7 +117,7 @@ BaResult bundle_adjust(const std::vector<Keyframe>& window, const std::vector<ge
         cf = new ceres::AutoDiffCostFunction<Reprojection<2>, 2, 3, 3, 3>(new Reprojection<2>{cam, o->uv, 0.0});
         res.residuals += 2;
       }
-      problem.AddResidualBlock(cf, &loss, pp[k].w, pp[k].t, X);
+      blocks.push_back(problem.AddResidualBlock(cf, &loss, pp[k].w, pp[k].t, X));
     }
     ++res.landmarks;
   }
@@ -138,11 +140,21 @@ BaResult bundle_adjust(const std::vector<Keyframe>& window, const std::vector<ge
   opts.max_num_iterations = params.max_iterations;
   opts.logging_type = ceres::SILENT;
   opts.num_threads = 1;
+  // Solve, drop the observations still off by more than outlier_px (mismatched tracks), solve again.
   ceres::Solver::Summary summary;
   ceres::Solve(opts, &problem, &summary);
-  const double n = std::max(1, res.residuals);
-  res.initial_rms_px = std::sqrt(2.0 * summary.initial_cost / n);
-  res.final_rms_px = std::sqrt(2.0 * summary.final_cost / n);
+  res.initial_rms_px = std::sqrt(2.0 * summary.initial_cost / std::max(1, res.residuals));
+  for (const auto id : blocks) {
+    double r[3] = {0, 0, 0}, cost = 0;
+    problem.EvaluateResidualBlock(id, false, &cost, r, nullptr);
+    if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > params.outlier_px * params.outlier_px) {
+      res.residuals -= problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+      problem.RemoveResidualBlock(id);
+      ++res.outliers;
+    }
+  }
+  if (res.outliers > 0) ceres::Solve(opts, &problem, &summary);
+  res.final_rms_px = std::sqrt(2.0 * summary.final_cost / std::max(1, res.residuals));
   for (size_t k = 0; k < window.size(); ++k) res.window.emplace_back(window[k].id, from_params(pp[k]));
   res.T_world_cam = res.window.back().second;
   res.ms = sw.ms();

@@ -40,6 +40,7 @@ struct BaParams {
   int window = 8;            // keyframes optimised together (the oldest is held fixed)
   int max_iterations = 15;
   double huber_px = 1.0;
+  double outlier_px = 2.0;   // observations off by more after the first solve are dropped
   int min_observations = 2;  // keyframes that must see a track for it to enter the problem
   double max_depth_m = 60.0; // observations farther than this add no depth constraint
   void validate(const std::string& what = "ba") const;
@@ -49,7 +50,7 @@ struct BaResult {
   int64_t keyframe_id = -1;      // the newest keyframe of the window
   geometry::SE3 T_world_cam;     // its refined pose
   std::vector<std::pair<int64_t, geometry::SE3>> window;  // all refined poses of the window
-  int landmarks = 0, residuals = 0;
+  int landmarks = 0, residuals = 0, outliers = 0;
   double initial_rms_px = 0, final_rms_px = 0;
   double ms = 0;                 // thread CPU time of the optimisation
 };

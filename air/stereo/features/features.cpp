@@ -90,6 +90,7 @@ FeatureFrame FeatureExtractor::extract(const cv::Mat& gray) {
 
   out.per_bucket.assign(static_cast<size_t>(p.buckets_x) * p.buckets_y, 0);
   std::vector<cv::KeyPoint> kps, inside;
+  std::vector<cv::Point2f> corners;
   const cv::Rect image(0, 0, gray.cols, gray.rows);
   for (int by = 0; by < p.buckets_y; ++by)
     for (int bx = 0; bx < p.buckets_x; ++bx) {
@@ -110,6 +111,16 @@ FeatureFrame FeatureExtractor::extract(const cv::Mat& gray) {
       cv::KeyPointsFilter::retainBest(inside, p.max_per_bucket);
       if (static_cast<int>(inside.size()) > p.max_per_bucket) inside.resize(p.max_per_bucket);  // ties
       const int bucket = by * p.buckets_x + bx;
+      if (p.subpixel && !inside.empty()) {
+        // FAST corners are whole pixels; the corner refinement (Foerstner, cv::cornerSubPix)
+        // moves each to the sub-pixel saddle point, which the matches then share.
+        corners.clear();
+        for (const auto& k : inside) corners.push_back(k.pt);
+        cv::cornerSubPix(smoothed_, corners, cv::Size(2, 2), cv::Size(-1, -1),
+                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.01));
+        for (size_t i = 0; i < inside.size(); ++i)
+          if (cv::norm(corners[i] - inside[i].pt) < 1.0) inside[i].pt = corners[i];
+      }
       for (const auto& k : inside) {
         Feature f;
         f.pt = k.pt;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "air/stereo/motion/residuals.hpp"
@@ -12,8 +13,9 @@
 namespace aerie::stereo {
 namespace {
 
-// Eqs. 4.14-4.15 scaled by (f_x, f_y) / z^k: at the solution each equals the reprojection
-// error in pixels times z^{k+1} / z^k, so near and far features weigh alike.
+// Eqs. 4.14-4.15 scaled by (f_x, f_y) / z^{k+1} (depth in frame k+1 under the current
+// estimate, held constant during a solve): near the solution each is the reprojection error
+// in pixels, so near and far features weigh alike.
 struct Cost3D {
   Eigen::Vector3d X;
   Eigen::Vector2d x;
@@ -27,8 +29,9 @@ struct Cost3D {
   }
 };
 
-// Eq. 4.16 scaled by f / |t| (|t| of the initial estimate, a constant), which makes it about
-// the image distance (pixels) of the feature from its epipolar line.
+// Eq. 4.16 scaled by f / |(l_1, l_2)|, l = t x R X^k the epipolar line of the feature in frame
+// k+1 under the current estimate (held constant during a solve): the residual is then the
+// distance (pixels) of the feature from its epipolar line.
 struct Cost2D {
   Eigen::Vector2d xk, xn;
   double s;
@@ -118,7 +121,20 @@ MotionResult MotionEstimator::estimate(const StereoCamera& cam, const std::vecto
   std::vector<bool> use3(c3.size()), use2(c2.size(), true);
   count_inliers(init, params_.ransac_threshold_px, &res.inlier_3d);
   use3 = res.inlier_3d;
-  const double s2 = params_.weight_2d * f / std::max(0.01, t.norm());
+  // Per-feature weights from the current estimate (recomputed before every solve).
+  std::vector<double> w3(c3.size()), w2(c2.size());
+  auto update_weights = [&] {
+    const Eigen::Matrix3d R = geometry::so3_exp<double>(w);
+    for (size_t i = 0; i < c3.size(); ++i) w3[i] = 1.0 / std::max(0.05, (R * c3[i].X_k + t).z());
+    for (size_t i = 0; i < c2.size(); ++i) {
+      const Eigen::Vector3d l = t.cross(R * Eigen::Vector3d(c2[i].x_k.x(), c2[i].x_k.y(), 1.0));
+      // Below 5 mm of translation the epipolar geometry carries no information: cap the weight.
+      w2[i] = params_.weight_2d * f / std::max(l.head<2>().norm(), 0.005);
+    }
+  };
+  auto cost3 = [&](size_t i) { return new Cost3D{c3[i].X_k, c3[i].x_next, cam.fx * w3[i], cam.fy * w3[i]}; };
+  auto cost2 = [&](size_t i) { return new Cost2D{c2[i].x_k, c2[i].x_next, w2[i]}; };
+  update_weights();
   ceres::HuberLoss loss(params_.huber_px);
   ceres::Solver::Options opts;
   opts.linear_solver_type = ceres::DENSE_QR;
@@ -133,35 +149,34 @@ MotionResult MotionEstimator::estimate(const StereoCamera& cam, const std::vecto
   std::vector<double> r3(2 * c3.size()), r2(c2.size());
   auto residuals_at = [&](const double* wp, const double* tp) {
     for (size_t i = 0; i < c3.size(); ++i) {
-      Cost3D c{c3[i].X_k, c3[i].x_next, cam.fx / c3[i].X_k.z(), cam.fy / c3[i].X_k.z()};
-      c(wp, tp, &r3[2 * i]);
+      const std::unique_ptr<Cost3D> c(cost3(i));
+      (*c)(wp, tp, &r3[2 * i]);
     }
     for (size_t i = 0; i < c2.size(); ++i) {
-      Cost2D c{c2[i].x_k, c2[i].x_next, s2};
-      c(wp, tp, &r2[i]);
+      const std::unique_ptr<Cost2D> c(cost2(i));
+      (*c)(wp, tp, &r2[i]);
     }
   };
   // 2D features start as inliers only if the initial motion already roughly satisfies them.
   residuals_at(w.data(), t.data());
-  for (size_t i = 0; i < c2.size(); ++i) use2[i] = r2[i] * r2[i] < 9 * thr2;
+  for (size_t i = 0; i < c2.size(); ++i) use2[i] = std::abs(r2[i]) < 3 * params_.weight_2d * params_.inlier_threshold_2d_px;
 
   for (int round = 0; round < params_.rounds; ++round) {
+    if (round > 0) update_weights();
     ceres::Problem problem(popts);
     for (size_t i = 0; i < c3.size(); ++i)
       if (use3[i])
-        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Cost3D, 2, 3, 3>(new Cost3D{
-                                     c3[i].X_k, c3[i].x_next, cam.fx / c3[i].X_k.z(), cam.fy / c3[i].X_k.z()}),
-                                 &loss, w.data(), t.data());
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Cost3D, 2, 3, 3>(cost3(i)), &loss, w.data(), t.data());
     if (params_.weight_2d > 0)
       for (size_t i = 0; i < c2.size(); ++i)
         if (use2[i])
-          problem.AddResidualBlock(
-              new ceres::AutoDiffCostFunction<Cost2D, 1, 3, 3>(new Cost2D{c2[i].x_k, c2[i].x_next, s2}), &loss,
-              w.data(), t.data());
+          problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Cost2D, 1, 3, 3>(cost2(i)), &loss, w.data(),
+                                   t.data());
     ceres::Solver::Summary summary;
     ceres::Solve(opts, &problem, &summary);
     res.iterations += static_cast<int>(summary.iterations.size());
 
+    update_weights();
     residuals_at(w.data(), t.data());
     res.inliers_3d = res.inliers_2d = 0;
     for (size_t i = 0; i < c3.size(); ++i) {
@@ -169,7 +184,7 @@ MotionResult MotionEstimator::estimate(const StereoCamera& cam, const std::vecto
       res.inliers_3d += res.inlier_3d[i];
     }
     for (size_t i = 0; i < c2.size(); ++i) {
-      res.inlier_2d[i] = params_.weight_2d > 0 && r2[i] * r2[i] < thr2;
+      res.inlier_2d[i] = params_.weight_2d > 0 && std::abs(r2[i]) < params_.weight_2d * params_.inlier_threshold_2d_px;
       res.inliers_2d += res.inlier_2d[i];
     }
     use3 = res.inlier_3d;
@@ -199,13 +214,9 @@ MotionResult MotionEstimator::estimate(const StereoCamera& cam, const std::vecto
       }
     };
     for (size_t i = 0; i < c3.size(); ++i)
-      if (res.inlier_3d[i])
-        add(ceres::AutoDiffCostFunction<Cost3D, 2, 3, 3>(
-                new Cost3D{c3[i].X_k, c3[i].x_next, cam.fx / c3[i].X_k.z(), cam.fy / c3[i].X_k.z()}),
-            2);
+      if (res.inlier_3d[i]) add(ceres::AutoDiffCostFunction<Cost3D, 2, 3, 3>(cost3(i)), 2);
     for (size_t i = 0; i < c2.size(); ++i)
-      if (res.inlier_2d[i])
-        add(ceres::AutoDiffCostFunction<Cost2D, 1, 3, 3>(new Cost2D{c2[i].x_k, c2[i].x_next, s2}), 1);
+      if (res.inlier_2d[i]) add(ceres::AutoDiffCostFunction<Cost2D, 1, 3, 3>(cost2(i)), 1);
   }
   res.rms_px = std::sqrt(sse / std::max(1, m));
   const double sigma2 = sse / std::max(1, m - 6);

@@ -27,6 +27,7 @@ struct MotionParams {
   int ransac_iterations = 100;
   double ransac_threshold_px = 2.0;  // reprojection error of an inlier in RANSAC
   double inlier_threshold_px = 2.0;  // residual (pixels) above which a feature is rejected after LM
+  double inlier_threshold_2d_px = 1.0;  // the same for features without depth (epipolar distance)
   double huber_px = 1.0;             // robust loss scale (pixels)
   double weight_2d = 1.0;            // weight of the 2D -> 2D residuals relative to the 3D ones
   int max_iterations = 20;           // LM iterations per round

@@ -1,6 +1,7 @@
 #include "air/stereo/vo/vo.hpp"
 
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -105,17 +106,16 @@ std::optional<double> StereoOdometry::refine_disparity(const cv::Mat& left, cons
   return dc + (best - r) + frac;
 }
 
-void StereoOdometry::assign_depth(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity,
-                                  Frame& frame) const {
+void StereoOdometry::assign_depth(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity, int s,
+                                  bool refine, Frame& frame) const {
   const double min_disparity = cam_.disparity(params_.max_depth_m);
-  const int s = params_.depth_scale;
   for (size_t j = 0; j < frame.feats.features.size(); ++j) {
     const cv::Point2f p = frame.feats.features[j].pt;
     const int x = std::min(disparity.cols - 1, cvRound(p.x) / s), y = std::min(disparity.rows - 1, cvRound(p.y) / s);
     const float d0 = disparity.at<float>(y, x);
     if (d0 < 0) continue;  // no dense depth here: keep what the track carried over
     std::optional<double> d = static_cast<double>(d0) * s;
-    if (params_.refine_radius > 0) d = refine_disparity(left, right, p, *d);
+    if (refine) d = refine_disparity(left, right, p, *d);
     if (!d || *d < min_disparity) continue;
     Track& t = frame.tracks[j];
     t.X = cam_.triangulate(p.x, p.y, *d);
@@ -147,6 +147,17 @@ void StereoOdometry::make_keyframe(int64_t utime, const Frame& frame) {
 }
 
 VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int64_t utime) {
+  return run(left, right, utime, nullptr);
+}
+
+VoResult StereoOdometry::process_with_disparity(const cv::Mat& left, const cv::Mat& right, int64_t utime,
+                                                const cv::Mat& disparity) {
+  if (disparity.type() != CV_32FC1 || disparity.size() != left.size())
+    throw std::invalid_argument("vo: the given disparity must be CV_32F of the image size");
+  return run(left, right, utime, &disparity);
+}
+
+VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t utime, const cv::Mat* given) {
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1)
     throw std::invalid_argument("vo: expected 8-bit gray rectified images");
   if (left.cols != cam_.width || left.rows != cam_.height || right.size() != left.size())
@@ -167,9 +178,13 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
   r.timings.features = sw.lap();
 
   // 2. Dense depth on one of every depth_every pairs, and always when (re)starting.
-  const bool depth_frame = !prev_ || (r.frame % params_.depth_every) == 0;
+  const bool depth_frame = given || !prev_ || (r.frame % params_.depth_every) == 0;
+  const int scale = given ? 1 : params_.depth_scale;
+  const bool refine = !given && params_.refine_radius > 0;
   cv::Mat disparity;
-  if (depth_frame) {
+  if (given) {
+    disparity = *given;
+  } else if (depth_frame) {
     if (params_.depth_scale == 1) {
       disparity = sgbm_.compute(left, right);
     } else {
@@ -183,11 +198,12 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
 
   if (!prev_) {
     for (auto& t : cur.tracks) t.id = next_track_++;
-    assign_depth(left, right, disparity, cur);
+    assign_depth(left, right, disparity, scale, refine, cur);
     r.status = restarted_ ? VoStatus::Reset : VoStatus::Initialising;
     r.message = restarted_ ? "tracking restarted: " + restart_reason_ : "first frame";
     restarted_ = false;
     for (const auto& t : cur.tracks) r.features_3d += t.has_depth;
+    cur.left = left.clone();
     prev_ = std::move(cur);
     make_keyframe(utime, *prev_);
     r.keyframe = true;
@@ -210,8 +226,28 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
     }
     MatchParams mp = params_.matching;
     if (last_motion_) mp.search_radius = params_.predicted_search_radius;
-    const auto matches = match_features(prev.feats.features, cur.feats.features, extractor_.descriptor_words(), mp,
-                                        last_motion_ ? &predicted : nullptr);
+    auto matches = match_features(prev.feats.features, cur.feats.features, extractor_.descriptor_words(), mp,
+                                  last_motion_ ? &predicted : nullptr);
+    if (params_.klt_window > 0 && !matches.empty()) {
+      std::vector<cv::Point2f> from, to;
+      for (const auto& m : matches) {
+        from.push_back(prev.feats.features[m.prev].pt);
+        to.push_back(cur.feats.features[m.cur].pt);
+      }
+      std::vector<uchar> ok;
+      std::vector<float> err;
+      cv::calcOpticalFlowPyrLK(prev.left, left, from, to, ok, err, cv::Size(params_.klt_window, params_.klt_window), 0,
+                               cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 10, 0.01),
+                               cv::OPTFLOW_USE_INITIAL_FLOW);
+      size_t kept = 0;
+      for (size_t k = 0; k < matches.size(); ++k) {
+        cv::Point2f& p = cur.feats.features[matches[k].cur].pt;
+        if (!ok[k] || cv::norm(to[k] - p) > 2.0) continue;  // the patch does not confirm the match
+        p = to[k];
+        matches[kept++] = matches[k];
+      }
+      matches.resize(kept);
+    }
     r.matches = static_cast<int>(matches.size());
     r.timings.matching = sw.lap();
 
@@ -279,8 +315,8 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
       }
     }
     if (depth_frame) {
-      assign_depth(left, right, disparity, cur);
-    } else if (params_.refine_radius > 0) {
+      assign_depth(left, right, disparity, scale, refine, cur);
+    } else if (refine) {
       // Between dense maps the carried-over depth predicts where each tracked feature lies in
       // the right image; a short search there measures its disparity afresh.
       const double min_disparity = cam_.disparity(params_.max_depth_m);
@@ -303,8 +339,9 @@ VoResult StereoOdometry::process(const cv::Mat& left, const cv::Mat& right, int6
     const bool want = !have_kf_ || tracked < params_.keyframe_min_tracked ||
                       since.translation().norm() > params_.keyframe_translation_m ||
                       geometry::rotation_angle(since.rotation_matrix()) * 180.0 / M_PI > params_.keyframe_rotation_deg;
+    cur.left = left.clone();
     prev_ = std::move(cur);
-    if (want && (depth_frame || params_.refine_radius > 0)) {
+    if (want && (depth_frame || refine)) {
       make_keyframe(utime, *prev_);
       r.keyframe = true;
     }

@@ -39,6 +39,10 @@ struct VoParams {
   FeatureParams features;
   MatchParams matching;
   double predicted_search_radius = 30.0;  // search radius when a motion prediction exists
+  // Matched positions refined by a Lucas-Kanade alignment of the previous frame's patch: the
+  // track then follows the same image point instead of the corner re-detected in every frame
+  // (re-detection shifts with viewpoint and scale, a bias that accumulates). 0 = off.
+  int klt_window = 11;
   MotionParams motion;
   int lost_min_inliers = 15;  // fewer 3D inliers: tracking lost
   // Keyframes: when fewer features than this are tracked from the last keyframe, or the
@@ -92,6 +96,11 @@ class StereoOdometry {
   // Rectified CV_8UC1 pair of the camera's size. Throws std::invalid_argument on a wrong
   // size or type (the caller reports it; the odometry state is unchanged).
   VoResult process(const cv::Mat& left, const cv::Mat& right, int64_t utime);
+  // Evaluation only: the same with a given full-resolution disparity map (CV_32F, e.g. the
+  // simulator's exact one) in place of SGBM_F and the feature disparity search, on every
+  // frame, to separate depth errors from tracking errors.
+  VoResult process_with_disparity(const cv::Mat& left, const cv::Mat& right, int64_t utime,
+                                  const cv::Mat& disparity);
   // Forgets the tracks and restarts from the current pose.
   void reset(const std::string& why);
   // Waits for the bundle adjuster to finish what it has (offline runs).
@@ -111,9 +120,12 @@ class StereoOdometry {
   struct Frame {
     FeatureFrame feats;
     std::vector<Track> tracks;
+    cv::Mat left;  // for the patch alignment of the next frame's matches
   };
 
-  void assign_depth(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity, Frame& frame) const;
+  VoResult run(const cv::Mat& left, const cv::Mat& right, int64_t utime, const cv::Mat* given_disparity);
+  void assign_depth(const cv::Mat& left, const cv::Mat& right, const cv::Mat& disparity, int scale, bool refine,
+                    Frame& frame) const;
   std::optional<double> refine_disparity(const cv::Mat& left, const cv::Mat& right, cv::Point2f p, double d0) const;
   void make_keyframe(int64_t utime, const Frame& frame);
 

@@ -1,5 +1,6 @@
 #include "air/stereo/vo/vo_config.hpp"
 
+#include <algorithm>
 #include <functional>
 #include <set>
 #include <stdexcept>
@@ -70,6 +71,7 @@ VoParams vo_params_from_config(const util::Config& cfg, const std::vector<std::s
   rd("features.fast_threshold", f.fast_threshold);
   rd("features.min_fast_threshold", f.min_fast_threshold);
   rd("features.smoothing_sigma", f.smoothing_sigma);
+  rd("features.subpixel", f.subpixel);
   rd("features.patch_size", f.patch_size);
   rd("features.descriptor_bits", f.descriptor_bits);
   rd("features.pattern_seed", f.pattern_seed);
@@ -79,11 +81,13 @@ VoParams vo_params_from_config(const util::Config& cfg, const std::vector<std::s
   rd("matching.search_radius", p.matching.search_radius);
   rd("matching.predicted_search_radius", p.predicted_search_radius);
   rd("matching.mutual", p.matching.mutual);
+  rd("matching.klt_window", p.klt_window);
 
   MotionParams& m = p.motion;
   rd("motion.ransac_iterations", m.ransac_iterations);
   rd("motion.ransac_threshold_px", m.ransac_threshold_px);
   rd("motion.inlier_threshold_px", m.inlier_threshold_px);
+  rd("motion.inlier_threshold_2d_px", m.inlier_threshold_2d_px);
   rd("motion.huber_px", m.huber_px);
   rd("motion.weight_2d", m.weight_2d);
   rd("motion.max_iterations", m.max_iterations);
@@ -99,6 +103,7 @@ VoParams vo_params_from_config(const util::Config& cfg, const std::vector<std::s
   rd("ba.window", p.ba.window);
   rd("ba.max_iterations", p.ba.max_iterations);
   rd("ba.huber_px", p.ba.huber_px);
+  rd("ba.outlier_px", p.ba.outlier_px);
   rd("ba.min_observations", p.ba.min_observations);
   rd("ba.max_depth_m", p.ba.max_depth_m);
   rd("ba.synchronous", p.ba_synchronous);

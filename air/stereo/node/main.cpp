@@ -1,0 +1,40 @@
+// aerie-vo: stereo visual odometry node. CAM_STEREO (rectified pairs) -> VO_POSE, VO_DEPTH,
+// STATUS_VO. See docs/stereo.md and config/vo.yaml.
+#include <spdlog/spdlog.h>
+
+#include "air/stereo/node/vo_node.hpp"
+#include "common/bus/node.hpp"
+#include "common/util/cli.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Stereo visual odometry: CAM_STEREO -> VO_POSE + VO_DEPTH (thesis ch. 4)", "aerie-vo"};
+  aerie::util::CommonOptions common;
+  aerie::util::add_common_options(app, common);
+  std::string input, pose, depth;
+  bool no_ba = false;
+  app.add_option("--input", input, "stereo channel (default from config: CAM_STEREO)");
+  app.add_option("--pose-channel", pose, "pose channel (default VO_POSE)");
+  app.add_option("--depth-channel", depth, "spherical depth channel (default VO_DEPTH; \"none\" turns it off)");
+  app.add_flag("--no-ba", no_ba, "run without the keyframe bundle adjustment");
+  CLI11_PARSE(app, argc, argv);
+  aerie::util::init_logging("vo", common.log_level);
+  try {
+    auto cfg = aerie::stereo::load_vo_node_config(common.config.empty() ? aerie::util::Config()
+                                                                          : aerie::util::Config::load(common.config));
+    if (!input.empty()) cfg.input = input;
+    if (!pose.empty()) cfg.pose = pose;
+    if (!depth.empty()) cfg.depth = depth == "none" ? "" : depth;
+    if (no_ba) cfg.vo.ba.enabled = false;
+    cfg.vo.ba_synchronous = false;  // a node never waits for the bundle adjustment
+    aerie::bus::Bus bus(common.lcm_url);
+    aerie::bus::StatusReporter status(bus, "VO");
+    aerie::stereo::VoNode node(bus, status, cfg);
+    spdlog::info("{} -> {}{}", cfg.input, cfg.pose, cfg.depth.empty() ? "" : ", " + cfg.depth);
+    aerie::bus::run(bus, status);
+    spdlog::info("stopped after {} stereo pairs ({} refused)", node.processed(), node.refused());
+    return 0;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}

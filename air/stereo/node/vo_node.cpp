@@ -1,0 +1,176 @@
+#include "air/stereo/node/vo_node.hpp"
+
+#include <aerie/pose_t.hpp>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "air/stereo/vo/vo_config.hpp"
+#include "common/image/image_message.hpp"
+#include "common/spherical/spherical_message.hpp"
+#include "common/util/time.hpp"
+
+namespace aerie::stereo {
+
+VoNodeConfig load_vo_node_config(const util::Config& cfg) {
+  VoNodeConfig c;
+  c.vo = vo_params_from_config(cfg, {"node"});
+  const util::Config n = cfg.section("node");
+  c.input = n.get<std::string>("input", c.input);
+  c.pose = n.get<std::string>("pose", c.pose);
+  c.depth = n.get<std::string>("depth", c.depth);
+  c.max_pair_skew_us = n.get<int64_t>("max_pair_skew_us", c.max_pair_skew_us);
+  c.spherical_resolution_deg = n.get<double>("spherical_resolution_deg", c.spherical_resolution_deg);
+  c.spherical_max_range_m = n.get<double>("spherical_max_range_m", c.spherical_max_range_m);
+  c.queue = n.get<int>("queue", c.queue);
+  for (const auto& kv : n.node()) {
+    static const char* known[] = {"input", "pose", "depth", "max_pair_skew_us", "spherical_resolution_deg",
+                                  "spherical_max_range_m", "queue"};
+    const auto key = kv.first.as<std::string>();
+    if (std::find(std::begin(known), std::end(known), key) == std::end(known))
+      throw std::runtime_error(cfg.origin() + ": unknown key 'node." + key + "'");
+  }
+  if (c.input.empty() || c.pose.empty()) throw std::runtime_error(cfg.origin() + ": node.input and node.pose are required");
+  if (c.max_pair_skew_us < 0 || c.queue < 1 || !(c.spherical_resolution_deg > 0) || !(c.spherical_max_range_m > 0))
+    throw std::runtime_error(cfg.origin() + ": node.max_pair_skew_us >= 0, node.queue >= 1 and positive spherical_*");
+  return c;
+}
+
+VoNode::VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg)
+    : bus_(bus), status_(status), cfg_(cfg) {
+  cfg_.vo.validate();
+  bus_.subscribe<aerie::stereo_image_t>(
+      cfg_.input, [this](const aerie::stereo_image_t& m, const bus::ReceiveInfo& info) { on_stereo(m, info.recv_utime); },
+      cfg_.queue);
+  status_.ok("waiting for " + cfg_.input);
+}
+
+VoNode::~VoNode() = default;
+
+void VoNode::check(const aerie::stereo_image_t& m) const {
+  const std::string what = cfg_.input + " seq " + std::to_string(m.seq) + ": ";
+  if (m.left.width != m.right.width || m.left.height != m.right.height)
+    throw std::invalid_argument(what + "left is " + std::to_string(m.left.width) + "x" + std::to_string(m.left.height) +
+                                " but right is " + std::to_string(m.right.width) + "x" +
+                                std::to_string(m.right.height));
+  if (std::llabs(m.left.utime - m.right.utime) > cfg_.max_pair_skew_us ||
+      std::llabs(m.utime - m.left.utime) > cfg_.max_pair_skew_us)
+    throw std::invalid_argument(what + "left/right/pair utimes " + std::to_string(m.left.utime) + " / " +
+                                std::to_string(m.right.utime) + " / " + std::to_string(m.utime) + " differ by more than " +
+                                std::to_string(cfg_.max_pair_skew_us) + " us");
+  if (!(m.fx > 0) || !(m.fy > 0) || !(m.baseline_m > 0) || !std::isfinite(m.cx) || !std::isfinite(m.cy))
+    throw std::invalid_argument(what + "fx, fy and baseline_m must be positive (rectified intrinsics)");
+}
+
+void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
+  cv::Mat left, right;
+  try {
+    check(m);
+    left = image::gray_from_message(m.left);
+    right = image::gray_from_message(m.right);
+  } catch (const std::exception& e) {
+    ++refused_;
+    status_.count("refused_pairs");
+    status_.warn(e.what());
+    spdlog::warn("refused stereo pair: {}", e.what());
+    return;
+  }
+  // A new camera (first pair, or size/intrinsics changed) or time going backwards (a log
+  // replayed from the start): start over.
+  const StereoCamera cam{m.fx, m.fy, m.cx, m.cy, m.baseline_m, left.cols, left.rows};
+  const bool new_camera = !vo_ || vo_->camera().width != cam.width || vo_->camera().height != cam.height ||
+                          vo_->camera().fx != cam.fx || vo_->camera().fy != cam.fy || vo_->camera().cx != cam.cx ||
+                          vo_->camera().cy != cam.cy || vo_->camera().baseline != cam.baseline;
+  try {
+    if (new_camera) {
+      if (vo_) spdlog::warn("camera changed on {}: restarting the odometry", cfg_.input);
+      vo_ = std::make_unique<StereoOdometry>(cam, cfg_.vo);
+      const int s = cfg_.vo.depth_scale;
+      spherical::EncoderConfig ec;
+      ec.angular_resolution_rad = static_cast<float>(cfg_.spherical_resolution_deg * M_PI / 180.0);
+      ec.max_range_m = static_cast<float>(cfg_.spherical_max_range_m);
+      const cv::Size depth_size((cam.width + s - 1) / s, (cam.height + s - 1) / s);
+      // Intrinsics of the dense map: pixel (x, y) of a half-resolution map is (2x + 0.5, 2y + 0.5) - 0.5.
+      const spherical::Intrinsics k{cam.fx / s, cam.fy / s, (cam.cx + 0.5) / s - 0.5, (cam.cy + 0.5) / s - 0.5,
+                                    cam.baseline};
+      encoder_ = cfg_.depth.empty() ? nullptr : std::make_unique<spherical::SphericalEncoder>(k, depth_size, ec);
+      spdlog::info("camera {}x{} f {:.1f} px baseline {:.3f} m; dense depth {}x{} every {} pairs", cam.width,
+                   cam.height, cam.fx, cam.baseline, depth_size.width, depth_size.height, cfg_.vo.depth_every);
+      status_.count("camera_changes");
+    } else if (m.utime <= last_utime_) {
+      vo_->reset("time went back from " + std::to_string(last_utime_) + " to " + std::to_string(m.utime));
+      status_.count("time_resets");
+    }
+    last_utime_ = m.utime;
+    const VoResult r = vo_->process(left, right, m.utime);
+    ++processed_;
+    publish(r, m.seq, receive_utime);
+    last_ = r;
+  } catch (const std::exception& e) {
+    // Not expected (the input was checked): report, keep the node alive, start over.
+    status_.count("errors");
+    status_.error(std::string("odometry failed: ") + e.what());
+    spdlog::error("odometry failed on {} seq {}: {}", cfg_.input, m.seq, e.what());
+    vo_.reset();
+  }
+}
+
+void VoNode::publish(const VoResult& r, int64_t seq, int64_t receive_utime) {
+  aerie::pose_t p{};
+  p.utime = r.utime;
+  p.seq = seq;
+  const auto& t = r.T_world_cam.translation();
+  for (int i = 0; i < 3; ++i) p.position[i] = t[i];
+  r.T_world_cam.to_wxyz(p.orientation);
+  for (int i = 0; i < 36; ++i) p.covariance[i] = r.covariance(i / 6, i % 6);
+  p.features_2d = r.features_2d;
+  p.features_3d = r.features_3d;
+  p.inliers = r.inliers;
+  p.keyframe = r.keyframe;
+  switch (r.status) {
+    case VoStatus::Ok: p.status = aerie::pose_t::OK; break;
+    case VoStatus::Initialising: p.status = aerie::pose_t::INITIALISING; break;
+    case VoStatus::Lost: p.status = aerie::pose_t::LOST; break;
+    case VoStatus::Reset: p.status = aerie::pose_t::RESET; break;
+  }
+  bus_.publish(cfg_.pose, p);
+  if (encoder_ && r.depth_computed) {
+    const spherical::SphericalDepth depth = encoder_->encode_disparity(r.disparity);
+    bus_.publish(cfg_.depth, spherical::to_message(depth, r.utime, seq, r.T_world_cam));
+    status_.count("depth_frames");
+  }
+  const int64_t now = util::wall_utime();
+  status_.mark_hop(r.utime, receive_utime, now);
+  status_.count("frames");
+  if (r.keyframe) status_.count("keyframes");
+  if (r.ba_applied) status_.count("ba_results");
+  if (r.status == VoStatus::Lost) {
+    status_.count("lost");
+    status_.warn(r.message);
+    spdlog::warn("frame {}: {}", r.frame, r.message);
+  } else if (r.status == VoStatus::Reset) {
+    status_.count("resets");
+    spdlog::info("frame {}: {}", r.frame, r.message);
+  } else {
+    status_.ok(to_string(r.status));
+  }
+  status_.set("features", r.features);
+  status_.set("matches", r.matches);
+  status_.set("features_3d", r.features_3d);
+  status_.set("features_2d", r.features_2d);
+  status_.set("inliers", r.inliers);
+  status_.set("inlier_ratio_permille", std::lround(1000 * r.inlier_ratio));
+  for (size_t b = 0; b < r.per_bucket.size(); ++b)
+    status_.set((b < 10 ? "bucket_0" : "bucket_") + std::to_string(b), r.per_bucket[b]);
+  status_.time_ms("depth", r.timings.depth);
+  status_.time_ms("features", r.timings.features);
+  status_.time_ms("matching", r.timings.matching);
+  status_.time_ms("motion", r.timings.motion);
+  status_.time_ms("other", r.timings.bookkeeping);
+  status_.time_ms("total", r.timings.total());
+  status_.time_ms("latency", static_cast<double>(now - receive_utime) * 1e-3);
+}
+
+}  // namespace aerie::stereo

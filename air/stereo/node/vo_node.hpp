@@ -1,0 +1,59 @@
+#pragma once
+// aerie-vo's LCM side: CAM_STEREO in; VO_POSE, VO_DEPTH and STATUS_VO out. The odometry
+// itself is air/stereo/vo; this class checks the input, converts messages and reports.
+#include <aerie/stereo_image_t.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "air/stereo/vo/vo.hpp"
+#include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
+#include "common/spherical/spherical_depth.hpp"
+#include "common/util/config.hpp"
+
+namespace aerie::stereo {
+
+struct VoNodeConfig {
+  VoParams vo;
+  std::string input = "CAM_STEREO";
+  std::string pose = "VO_POSE";
+  std::string depth = "VO_DEPTH";  // "" = no VO_DEPTH
+  int64_t max_pair_skew_us = 1000;
+  double spherical_resolution_deg = 0.5;
+  double spherical_max_range_m = 20.0;
+  int queue = 4;
+};
+// config/vo.yaml: the VO keys and the "node" section.
+VoNodeConfig load_vo_node_config(const util::Config& cfg);
+
+class VoNode {
+ public:
+  VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg);
+  ~VoNode();
+
+  // Handles one stereo pair (also called by the subscription). Never throws: refused pairs
+  // are logged and counted.
+  void on_stereo(const aerie::stereo_image_t& msg, int64_t receive_utime);
+
+  int64_t processed() const { return processed_; }
+  int64_t refused() const { return refused_; }
+  const std::optional<VoResult>& last() const { return last_; }
+
+ private:
+  // Throws std::invalid_argument with the reason when the pair cannot be used.
+  void check(const aerie::stereo_image_t& msg) const;
+  void publish(const VoResult& r, int64_t seq, int64_t receive_utime);
+
+  bus::Bus& bus_;
+  bus::StatusReporter& status_;
+  VoNodeConfig cfg_;
+  std::unique_ptr<StereoOdometry> vo_;
+  std::unique_ptr<spherical::SphericalEncoder> encoder_;
+  int64_t last_utime_ = -1;
+  int64_t processed_ = 0, refused_ = 0, seq_ = 0;
+  std::optional<VoResult> last_;
+};
+
+}  // namespace aerie::stereo

@@ -1,0 +1,102 @@
+// aerie-vo's node class over memq://: stereo pairs in, VO_POSE / VO_DEPTH out; refused and
+// malformed inputs are counted and never stop it.
+#include <gtest/gtest.h>
+
+#include <aerie/pose_t.hpp>
+#include <aerie/spherical_depth_t.hpp>
+
+#include <opencv2/imgproc.hpp>
+
+#include "air/stereo/node/vo_node.hpp"
+#include "common/image/image_message.hpp"
+#include "common/sim/simulation.hpp"
+
+using namespace aerie;
+
+namespace {
+
+aerie::stereo_image_t to_message(const sim::StereoFrame& f, const sim::Intrinsics& K) {
+  aerie::stereo_image_t m;
+  m.utime = f.utime;
+  m.seq = f.seq;
+  m.left = image::to_message(f.left, f.utime, f.seq);
+  m.right = image::to_message(f.right, f.utime, f.seq);
+  m.fx = K.fx;
+  m.fy = K.fy;
+  m.cx = K.cx;
+  m.cy = K.cy;
+  m.baseline_m = K.baseline;
+  return m;
+}
+
+}  // namespace
+
+TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "VO");
+  std::vector<aerie::pose_t> poses;
+  int depth_msgs = 0;
+  bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t& p, const bus::ReceiveInfo&) { poses.push_back(p); });
+  bus.subscribe<aerie::spherical_depth_t>("VO_DEPTH",
+                                          [&](const aerie::spherical_depth_t&, const bus::ReceiveInfo&) { ++depth_msgs; });
+  stereo::VoNodeConfig cfg;
+  cfg.vo.ba.enabled = false;
+  stereo::VoNode node(bus, status, cfg);
+
+  const sim::World world = sim::World::room(sim::WorldConfig{});
+  sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+  const auto K = simulation.intrinsics();
+  sim::StereoFrame f;
+  for (int i = 0; i < 6 && simulation.next(f); ++i) {
+    bus.publish("CAM_STEREO", to_message(f, K));
+    while (bus.handle(0) > 0) {
+    }
+  }
+  ASSERT_EQ(node.processed(), 6);
+  ASSERT_EQ(poses.size(), 6u);
+  EXPECT_EQ(poses[0].status, aerie::pose_t::INITIALISING);
+  EXPECT_EQ(poses[5].status, aerie::pose_t::OK);
+  EXPECT_EQ(poses[5].utime, f.utime);
+  EXPECT_GT(poses[5].features_3d, 50);
+  EXPECT_EQ(depth_msgs, 3);  // dense depth on one of every two pairs
+  // The pose follows the ground truth (the camera moved ~25 cm in 5 frames).
+  const geometry::SE3 T = geometry::SE3::from_wxyz(poses[5].orientation, poses[5].position);
+  sim::StereoFrame f0 = simulation.frame(0);
+  const geometry::SE3 truth = f0.T_world_left.inverse() * f.T_world_left;
+  EXPECT_LT((T.translation() - truth.translation()).norm(), 0.02);
+
+  // Mismatched sizes, mismatched timestamps, a corrupt payload: refused, counted, no pose.
+  simulation.next(f);
+  auto bad = to_message(f, K);
+  cv::Mat small;
+  cv::resize(f.right, small, cv::Size(188, 120));
+  bad.right = image::to_message(small, f.utime, f.seq);
+  node.on_stereo(bad, 0);
+  bad = to_message(f, K);
+  bad.right.utime += 40000;
+  node.on_stereo(bad, 0);
+  bad = to_message(f, K);
+  bad.left.size = 10;
+  bad.left.data.resize(10);
+  node.on_stereo(bad, 0);
+  bad = to_message(f, K);
+  bad.baseline_m = 0;
+  node.on_stereo(bad, 0);
+  EXPECT_EQ(node.refused(), 4);
+  EXPECT_EQ(status.counter("refused_pairs"), 4);
+  EXPECT_EQ(node.processed(), 6);
+  // A garbage message on the channel is counted by the bus and dropped.
+  const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
+  bus.raw().publish("CAM_STEREO", junk, sizeof junk);
+  while (bus.handle(0) > 0) {
+  }
+  // And the node goes on with good pairs.
+  node.on_stereo(to_message(f, K), 0);
+  EXPECT_EQ(node.processed(), 7);
+  ASSERT_TRUE(node.last().has_value());
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  // Time going backwards (a replayed log) restarts the odometry and says so.
+  node.on_stereo(to_message(simulation.frame(0), K), 0);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Reset);
+  EXPECT_EQ(status.counter("time_resets"), 1);
+}
