@@ -50,16 +50,31 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
         status_.count("pose_not_ok");  // initialising/lost: no heading, the fallback takes over when stale
         return;
       }
-      on_heading(m.utime, heading_from_quaternion(m.orientation, opt_.frame), info.recv_utime);
+      on_pose(m.utime, m.orientation, info.recv_utime);
     });
   } else {
     bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo& info) {
-      on_heading(m.utime, heading_from_quaternion(m.orientation, opt_.frame), info.recv_utime);
+      on_pose(m.utime, m.orientation, info.recv_utime);
     });
   }
   bus_.subscribe<aerie::flc_params_t>(opt_.params_channel,
                                       [this](const aerie::flc_params_t& m, const bus::ReceiveInfo&) { on_params(m); });
   status_.ok("controller " + loop_.controller().id);
+}
+
+void ControlNode::on_pose(int64_t utime, const double orientation[4], int64_t receive_us) {
+  double heading = 0.0;
+  try {
+    heading = heading_from_quaternion(orientation, opt_.frame);
+  } catch (const std::invalid_argument& e) {
+    // Counted, shown in the status, logged once per 100 so that a wrong frame does not flood the log.
+    status_.count("bad_pose");
+    status_.warn(std::string("pose on ") + opt_.pose_channel + ": " + e.what());
+    if (bad_poses_++ % 100 == 0)
+      spdlog::warn("pose on {}: {} ({} so far; check heading_frame)", opt_.pose_channel, e.what(), bad_poses_);
+    return;
+  }
+  on_heading(utime, heading, receive_us);
 }
 
 void ControlNode::on_heading(int64_t utime, double heading_deg, int64_t receive_us) {

@@ -41,6 +41,7 @@ class ControlNode {
   const ControlLoop& loop() const { return loop_; }
 
  private:
+  void on_pose(int64_t utime, const double orientation[4], int64_t receive_us);
   void on_heading(int64_t utime, double heading_deg, int64_t receive_us);
   void on_params(const aerie::flc_params_t& m);
 
@@ -50,6 +51,7 @@ class ControlNode {
   ControlLoop loop_;
   int64_t seq_ = 0, next_publish_ = 0, period_us_ = 0, last_receive_ = 0;
   bool stale_reported_ = false;
+  int64_t bad_poses_ = 0;
 };
 
 }  // namespace aerie::control

@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
       cmd = m;
       status.count("commands");
     });
-    spdlog::info("vehicle {} from y = {} m, wall at {} m, dangerous area from {} m; GT_POSE at {} Hz", scen.vehicle.name, start_y,
-                 scen.scene.wall_y_m, scen.scene.dangerous_from(), rate_hz);
+    spdlog::info("vehicle {} from y = {} m, wall at {} m, dangerous area from {} m; poses on {} at {} Hz", scen.vehicle.name, start_y,
+                 scen.scene.wall_y_m, scen.scene.dangerous_from(), pose_channel, rate_hz);
 
     const int64_t t0 = util::wall_utime();
     long steps = 0;

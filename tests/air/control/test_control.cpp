@@ -143,9 +143,11 @@ TEST(ControlConfig, ConfigFileAndErrors) {
   CliOverrides cli;
   cli.input = "gt";
   cli.reference_deg = -90.0;
-  const auto gt = node_setup(util::Config(), cli);
+  const auto gt = node_setup(util::Config::load(std::string(AERIE_SOURCE_DIR) + "/config/control.yaml"), cli);
   EXPECT_EQ(gt.options.input, NodeOptions::Input::kGtPose);
-  EXPECT_EQ(gt.options.frame.up, Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(gt.options.frame.up, Eigen::Vector3d(0, 0, 1));  // the shipped config keeps the per-input defaults
+  EXPECT_EQ(gt.options.frame.forward, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(gt.options.pose_channel, "GT_POSE");
   EXPECT_DOUBLE_EQ(gt.options.control.reference_deg, -90.0);
   try {
     node_setup(util::Config::parse("stale_timeout_s: -1\n", "c.yaml"));
@@ -247,4 +249,14 @@ TEST(ControlNode, RefusesMalformedParametersAndTimesOutToHover) {
   drain(bus);
   EXPECT_EQ(counter("pose_not_ok"), 1);
   EXPECT_EQ(counter("poses"), 1);
+  // A pose whose optical axis is vertical has no heading: counted and dropped.
+  aerie::pose_t down = vo_pose(3'000'000, 0.0);
+  quaternion(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d(1, 0, 0))), down.orientation);
+  bus.publish("VO_POSE", down);
+  drain(bus);
+  status.publish_now();
+  drain(bus);
+  EXPECT_EQ(counter("bad_pose"), 1);
+  EXPECT_EQ(counter("VO_POSE.handler_errors"), 0);
+  EXPECT_NE(last_status.message.find("vertical"), std::string::npos) << last_status.message;
 }
