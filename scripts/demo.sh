@@ -68,7 +68,9 @@ capture+=("${capture_extra[@]}")
 EXTRA_PROCESSES=(
   # air: track the helipad (initialised on its ground-truth box after 20 frames; 1 m pad)
   "$BIN/aerie-track --camera CAM_LEFT --init-from-gt 20 --target-size 1.0"
-  # air: the fuzzy heading controller (on the ground-truth heading until VO lands in the demo)
+  # air: stereo visual odometry and compact depth for the map
+  "$BIN/aerie-vo --config config/vo.yaml"
+  # air: the fuzzy heading controller, on the simulator's ground-truth heading
   "$BIN/aerie-control --input gt"
   # ground: the occupancy map, saved next to the log at the end
   "$BIN/aerie-map --config config/map.yaml --save ${LOG%.lcm}-map.bt"

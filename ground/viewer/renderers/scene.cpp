@@ -237,13 +237,7 @@ void OctomapRenderer::subscribe(bus::Bus& bus) {
         if (m.full || !map_->tree || map_->tree->getResolution() != incoming->getResolution()) {
           map_->tree = std::move(incoming);
         } else {
-          // A changed region: replace what the local copy holds inside the box.
-          const octomap::point3d lo(m.bbox_min[0], m.bbox_min[1], m.bbox_min[2]);
-          const octomap::point3d hi(m.bbox_max[0], m.bbox_max[1], m.bbox_max[2]);
-          std::vector<octomap::OcTreeKey> stale;
-          for (auto it = map_->tree->begin_leafs_bbx(lo, hi); it != map_->tree->end_leafs_bbx(); ++it)
-            stale.push_back(it.getKey());
-          for (const auto& k : stale) map_->tree->deleteNode(k);
+          // A changed region: its leaves (occupied and free) overwrite the local copy.
           for (auto it = incoming->begin_leafs(); it != incoming->end_leafs(); ++it)
             map_->tree->setNodeValue(it.getCoordinate(), it->getLogOdds(), true);
         }
