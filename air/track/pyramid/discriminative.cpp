@@ -160,9 +160,8 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
       if (!grid.empty()) {
         L.classifier->score(L.ch, grid, scale_, scores);
         const size_t b = std::max_element(scores.begin(), scores.end()) - scores.begin();
-        out.prominence = prominence(scores, L.classifier->terms());
         c = centre_of(grid.positions()[b], box);
-        radius = stride + 0.5;
+        radius = std::max(radius, stride + 0.5);  // the usual disc around the best grid sample
         LevelStats scan_stats;
         scan_stats.level = p;
         scan_stats.evaluated = static_cast<int>(grid.size());
@@ -189,7 +188,7 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
     st.scores = scores;
 
     c = centre_of(l, box);
-    if (p == top && !scan) out.prominence = prominence(scores, L.classifier->terms());
+    if (p == top) out.prominence = prominence(scores, L.classifier->terms());  // same disc as when tracking
     if (p > 0) {
       // eq. 3.25: reject the xi^p N_S lowest-scoring samples; the best rejected one is the
       // critical sample and its distance to l^p the critical distance CD^p.
@@ -325,21 +324,27 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
     mean_prominence_ += rate * (z - mean_prominence_);
     learn();
   };
+  // Without confident frames the reference drifts slowly towards what is seen, so that a
+  // lasting change of appearance ends the freeze (and a loss) instead of making it permanent.
+  auto drift = [&] { mean_prominence_ += 0.25 * params_.confidence_rate * (z - mean_prominence_); };
 
   if (!lost_) {
     // Hysteresis: once below update_confidence, learning resumes only at found_confidence.
     const bool uncertain = low_frames_ > 0 ? conf < params_.found_confidence : conf < params_.update_confidence;
     low_frames_ = uncertain ? low_frames_ + 1 : 0;
-    if (low_frames_ == 0)
+    if (low_frames_ == 0) {
       confident_frame();
-    else if (params_.redetection && low_frames_ >= params_.lost_frames)
-      lost_ = true;
-  } else if (conf >= params_.found_confidence) {
+    } else {
+      drift();
+      if (params_.redetection && low_frames_ >= params_.lost_frames) lost_ = true;
+    }
+  } else if (conf >= params_.found_confidence) {  // lost, found again
     lost_ = false;
     low_frames_ = 0;
     state.redetected = true;
     confident_frame();
   } else {
+    drift();
     centre_ = previous;  // still lost: report where the target was last seen
     scale_ = previous_scale;
   }
