@@ -32,7 +32,7 @@ struct AppearanceParams {
   // Every update block also holds the first observation: the subspace keeps the initial
   // appearance (against drift; the similarity-normalised patch of a rigid target at the right
   // pose always looks like it).
-  bool anchor = false;
+  bool anchor = true;
   ObservationParams likelihood;
   // An observation enters the next update block only when its mean robust residual
   // (ObservationScore::residual) is below this (guards the subspace against occluders).

@@ -214,20 +214,25 @@ TEST(Ipsl, LossMonitorDetectsAndRecovers) {
 }
 
 TEST(Ipsl, SubspaceIsUpdatedEveryBlock) {
-  IpslParams p;
-  p.appearance.block_size = 5;
-  IpslTracker t(p, 1);
-  const auto s = make_sequence(11, translation);
-  t.init(s.frames[0], s.init_box);
-  for (int k = 1; k <= 4; ++k) t.update(s.frames[k]);  // init + 4 observations = 1 block
-  EXPECT_NEAR(t.subspace().count(), 5, 1e-9);
-  EXPECT_EQ(t.subspace().rank(), 4);
-  for (int k = 5; k <= 9; ++k) t.update(s.frames[k]);
-  EXPECT_NEAR(t.subspace().count(), 0.95 * 5 + 5, 1e-9);
-  EXPECT_EQ(t.subspace().rank(), 9);
-  const TrackState st = t.update(s.frames[10]);
-  ASSERT_EQ(st.levels.size(), 1u);
-  EXPECT_EQ(st.levels[0].evaluated, p.particles);
+  for (const bool anchor : {false, true}) {
+    IpslParams p;
+    p.appearance.block_size = 5;
+    p.appearance.anchor = anchor;
+    IpslTracker t(p, 1);
+    const auto s = make_sequence(11, translation);
+    t.init(s.frames[0], s.init_box);
+    for (int k = 1; k <= 4; ++k) t.update(s.frames[k]);  // init + 4 observations = 1 block
+    EXPECT_NEAR(t.subspace().count(), 5, 1e-9);
+    EXPECT_EQ(t.subspace().rank(), 4);
+    for (int k = 5; k <= 9; ++k) t.update(s.frames[k]);
+    // eq. 3.4: n = eta n + m; the anchored block also holds the first observation.
+    const int m = anchor ? 6 : 5;
+    EXPECT_NEAR(t.subspace().count(), 0.95 * 5 + m, 1e-9);
+    EXPECT_EQ(t.subspace().rank(), 9);  // 10 distinct observations (the anchor repeats the first)
+    const TrackState st = t.update(s.frames[10]);
+    ASSERT_EQ(st.levels.size(), 1u);
+    EXPECT_EQ(st.levels[0].evaluated, p.particles);
+  }
 }
 
 TEST(Ipsl, DeterministicForASeed) {
