@@ -274,6 +274,7 @@ struct Overrides {
   std::vector<double> resolutions{0.05, 0.1, 0.2};
   float bin_deg = 1.0f;
   uint64_t seed = 1;
+  bool skip_octomap = false;  // parameter studies of the robust update only
   void apply(OccupancyParams& p) const {
     if (disparity_sigma >= 0) p.stereo.disparity_sigma_px = disparity_sigma;
     if (free_margin >= 0) p.stereo.free_margin_sigmas = free_margin;
@@ -300,16 +301,21 @@ int run_quality(const fs::path& out, Noise noise, int stride, int max_frames, do
     OccupancyMap map(params);
     double t_plain = 0, t_ours = 0;
     for (const auto& f : s.frames) {
-      const auto pc = to_octomap(f.points);
       auto t0 = std::chrono::steady_clock::now();
-      tree->insertPointCloud(pc, octomap::point3d(f.origin.x(), f.origin.y(), f.origin.z()), range);
-      t_plain += seconds_since(t0);
+      if (!ov.skip_octomap) {
+        const auto pc = to_octomap(f.points);
+        t0 = std::chrono::steady_clock::now();
+        tree->insertPointCloud(pc, octomap::point3d(f.origin.x(), f.origin.y(), f.origin.z()), range);
+        t_plain += seconds_since(t0);
+      }
       t0 = std::chrono::steady_clock::now();
       map.insert_frame(f.points, f.origin);
       t_ours += seconds_since(t0);
     }
-    for (const auto& [name, q, t] : {std::tuple{"octomap", evaluate(*tree, s.world), t_plain},
-                                     std::tuple{"robust", evaluate(map.tree(), s.world), t_ours}}) {
+    std::vector<std::tuple<const char*, Quality, double>> results;
+    if (!ov.skip_octomap) results.emplace_back("octomap", evaluate(*tree, s.world), t_plain);
+    results.emplace_back("robust", evaluate(map.tree(), s.world), t_ours);
+    for (const auto& [name, q, t] : results) {
       const double art = 100.0 * static_cast<double>(q.artifacts) / std::max<size_t>(1, q.occupied);
       const double wf = 100.0 * static_cast<double>(q.wrongly_free) / std::max<size_t>(1, q.solid_known);
       const double surf = 100.0 * static_cast<double>(q.surface_occupied) / std::max<size_t>(1, q.surface_known);
@@ -405,6 +411,7 @@ int main(int argc, char** argv) {
   ql->add_option("--resolutions", ov.resolutions, "map resolutions (m)")->capture_default_str();
   ql->add_option("--bin-deg", ov.bin_deg, "spherical bin size of VO_DEPTH (deg)")->capture_default_str();
   ql->add_option("--world-seed", ov.seed, "WorldConfig::seed of the room (layout, textures)")->capture_default_str();
+  ql->add_flag("--skip-octomap", ov.skip_octomap, "evaluate the robust update only (parameter studies)");
   ql->add_option("--disparity-sigma", ov.disparity_sigma, "override stereo/disparity_sigma_px");
   ql->add_option("--free-margin", ov.free_margin, "override stereo/free_margin_sigmas");
   ql->add_option("--visibility", ov.visibility, "override visibility_if_occluded");

@@ -5,6 +5,7 @@
 // 376x240 sequence. Writes <out>/ipsl_otb.csv and prints a table.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -198,8 +199,11 @@ int main(int argc, char** argv) {
                 << "  fps " << m.fps << "  samples " << m.samples << "\n";
     }
   } catch (const std::exception& e) {
-    std::cerr << "ipsl_otb: " << e.what() << "\n";
+    std::cerr << "aerie-bench-ipsl: " << e.what() << "\n";
     return 1;
   }
+  // Success and precision plots (matplotlib of the system Python, see NOTES.md).
+  const std::string plot = "/usr/bin/python3 " AERIE_SOURCE_DIR "/bench/track_ipsl/plot_ipsl.py '" + out + "'";
+  if (std::system(plot.c_str()) != 0) std::cerr << "aerie-bench-ipsl: plotting failed: " << plot << "\n";
   return 0;
 }

@@ -47,9 +47,9 @@ struct OccupancyParams {
   struct Stereo {
     double focal_px = 163.0;          // of the rectified camera that produced the depth (demo rig)
     double baseline_m = 0.12;
-    double disparity_sigma_px = 0.1;  // disparity noise of a VO_DEPTH bin (median of its pixels);
-                                      // 0 disables the depth error model
-    double free_margin_sigmas = 2.0;  // free space stops this many sigma_r before a hit
+    double disparity_sigma_px = 0.12;  // disparity noise of a VO_DEPTH bin (median of its pixels);
+                                       // 0 disables the depth error model
+    double free_margin_sigmas = 1.25;  // free space stops this many sigma_r before a hit
     bool weight_hits = true;          // hit weight = P(depth inside the voxel); false: full hits
     // Stereo range error (m) at range r: sigma_r = r^2 sigma_d / (f b).
     double range_sigma(double r) const {

@@ -1,6 +1,7 @@
 #include "air/track/ipsl/appearance.hpp"
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -14,31 +15,15 @@ void warp_patch(const cv::Mat& image, const Similarity& pose, const cv::Size2d& 
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   const double ax = pose.scale * template_size.width / P, ay = pose.scale * template_size.height / P;
   const double h = (P - 1) / 2.0;
-  // Source position is affine in (u, v): step du along a patch row, dv down a column.
-  const float du_x = static_cast<float>(c * ax), du_y = static_cast<float>(s * ax);
-  const double dv_x = -s * ay, dv_y = c * ay;
-  const float max_x = static_cast<float>(image.cols - 1), max_y = static_cast<float>(image.rows - 1);
-  const int last_col = image.cols - 1, last_row = image.rows - 1;
-  const size_t step = image.step[0];
-  const uchar* data = image.data;
-  constexpr float kScale = 1.0f / 255.0f;
-  for (int v = 0; v < P; ++v) {
-    const float x0 = static_cast<float>(pose.x + dv_x * (v - h) - du_x * h);
-    const float y0 = static_cast<float>(pose.y + dv_y * (v - h) - du_y * h);
-    float* row = out + static_cast<size_t>(v) * P;
-    for (int u = 0; u < P; ++u) {
-      const float sx = std::clamp(x0 + du_x * u, 0.0f, max_x);
-      const float sy = std::clamp(y0 + du_y * u, 0.0f, max_y);
-      const int ix = static_cast<int>(sx), iy = static_cast<int>(sy);
-      const float fx = sx - ix, fy = sy - iy;
-      const int ix1 = std::min(ix + 1, last_col);
-      const uchar* r0 = data + iy * step;
-      const uchar* r1 = data + std::min(iy + 1, last_row) * step;
-      const float top = r0[ix] + fx * (r0[ix1] - r0[ix]);
-      const float bottom = r1[ix] + fx * (r1[ix1] - r1[ix]);
-      row[u] = (top + fy * (bottom - top)) * kScale;
-    }
-  }
+  // Inverse map patch (u, v) -> image: [c ax, -s ay; s ax, c ay] (u - h, v - h) + centre.
+  const double m[6] = {c * ax, -s * ay, pose.x - h * (c * ax - s * ay),
+                       s * ax, c * ay,  pose.y - h * (s * ax + c * ay)};
+  // OpenCV's warp is vectorised (SSE/AVX/NEON through its universal intrinsics) and reads only
+  // the pixels it needs; the 8-bit patch goes to [0, 1] floats.
+  thread_local cv::Mat patch;
+  cv::warpAffine(image, patch, cv::Mat(2, 3, CV_64F, const_cast<double*>(m)), {P, P},
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  patch.convertTo(cv::Mat(P, P, CV_32F, out), CV_32F, 1.0 / 255.0);
 }
 
 void normalize_patch(float* v, int n) {
@@ -54,11 +39,11 @@ void normalize_patch(float* v, int n) {
 }
 
 AppearanceModel::AppearanceModel(int dim, int max_basis, double forgetting, int block_size,
-                                 const ObservationParams& params)
-    : pca_(dim, max_basis, forgetting), block_size_(block_size), params_(params) {
+                                 const ObservationParams& params, bool anchor)
+    : pca_(dim, max_basis, forgetting), block_size_(block_size), params_(params), anchor_(anchor) {
   if (block_size < 1)
     throw std::invalid_argument("AppearanceModel: block_size must be >= 1, got " + std::to_string(block_size));
-  block_.resize(dim, block_size);
+  block_.resize(dim, block_size + 1);
   mean_ = Eigen::VectorXf::Zero(dim);
   basis_.resize(dim, 0);
 }
@@ -70,6 +55,7 @@ void AppearanceModel::init(const Eigen::Ref<const Eigen::VectorXf>& first) {
   mean_ = first;
   basis_.resize(dim(), 0);
   inv_variance_.resize(0);
+  block_.col(block_size_) = first.cast<double>();  // the anchor column
   add(first);
 }
 
@@ -77,7 +63,9 @@ bool AppearanceModel::add(const Eigen::Ref<const Eigen::VectorXf>& observation) 
   if (observation.size() != dim()) throw std::invalid_argument("AppearanceModel::add: wrong observation length");
   block_.col(pending_++) = observation.cast<double>();
   if (pending_ < block_size_) return false;
-  pca_.update(block_.leftCols(pending_));
+  // With the anchor, every later block also holds the first observation, so that the subspace
+  // never forgets the initial appearance (the first block already has it).
+  pca_.update(block_.leftCols(anchor_ && !pca_.empty() ? pending_ + 1 : pending_));
   pending_ = 0;
   refresh();
   return true;

@@ -46,7 +46,9 @@ void normalize_patch(float* v, int n);
 // observations waiting for the next incremental update, and the likelihood.
 class AppearanceModel {
  public:
-  AppearanceModel(int dim, int max_basis, double forgetting, int block_size, const ObservationParams& params);
+  // anchor: every update block after the first also holds the first observation.
+  AppearanceModel(int dim, int max_basis, double forgetting, int block_size, const ObservationParams& params,
+                  bool anchor = false);
 
   // Starts from the first observation: it is the mean until the first update (the first
   // block, which includes it, is learnt by a batch SVD).
@@ -70,7 +72,8 @@ class AppearanceModel {
   IncrementalPca pca_;
   int block_size_;
   ObservationParams params_;
-  Eigen::MatrixXd block_;
+  bool anchor_;
+  Eigen::MatrixXd block_;  // block_size observations + the first one (the anchor column)
   int pending_ = 0;
   Eigen::VectorXf mean_;
   Eigen::MatrixXf basis_;

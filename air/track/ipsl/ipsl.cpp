@@ -37,7 +37,12 @@ void validate_common(const std::string& what, const MotionSigma& s, const Appear
   require(std::isfinite(a.update_max_residual) && a.update_max_residual >= 0, what, "update_max_residual",
           a.update_max_residual);
   require(std::isfinite(r.lost_residual) && r.lost_residual >= 0, what, "lost_residual", r.lost_residual);
+  require(std::isfinite(r.lost_ratio) && r.lost_ratio >= 1, what, "lost_ratio", r.lost_ratio);
+  require(std::isfinite(r.ratio_floor) && r.ratio_floor >= 0, what, "ratio_floor", r.ratio_floor);
+  require(std::isfinite(r.typical_rate) && r.typical_rate > 0 && r.typical_rate <= 1, what, "typical_rate",
+          r.typical_rate);
   require(std::isfinite(r.growth) && r.growth >= 1, what, "recovery_growth", r.growth);
+  require(r.max_lost_frames >= 0, what, "max_lost_frames", r.max_lost_frames);
   require(std::isfinite(r.max_factor) && r.max_factor >= 1, what, "recovery_max_factor", r.max_factor);
 }
 
@@ -51,13 +56,18 @@ void read_common(const util::Config& c, MotionSigma& s, AppearanceParams& a, Rec
   a.block_size = c.get("block_size", a.block_size);
   a.forgetting = c.get("forgetting", a.forgetting);
   a.normalize_patches = c.get("normalize_patches", a.normalize_patches);
+  a.anchor = c.get("anchor", a.anchor);
   a.likelihood.robust_scale = c.get("robust_scale", a.likelihood.robust_scale);
   a.likelihood.to_temperature = c.get("to_temperature", a.likelihood.to_temperature);
   a.likelihood.within_weight = c.get("within_weight", a.likelihood.within_weight);
   a.likelihood.within_epsilon = c.get("within_epsilon", a.likelihood.within_epsilon);
   a.update_max_residual = c.get("update_max_residual", a.update_max_residual);
   r.lost_residual = c.get("lost_residual", r.lost_residual);
+  r.lost_ratio = c.get("lost_ratio", r.lost_ratio);
+  r.ratio_floor = c.get("ratio_floor", r.ratio_floor);
+  r.typical_rate = c.get("typical_rate", r.typical_rate);
   r.growth = c.get("recovery_growth", r.growth);
+  r.max_lost_frames = c.get("max_lost_frames", r.max_lost_frames);
   r.max_factor = c.get("recovery_max_factor", r.max_factor);
 }
 
@@ -109,6 +119,7 @@ HierarchicalIpslParams hierarchical_ipsl_params_from_config(const util::Config& 
   p.max_range = c.get("max_range", p.max_range);
   p.min_theta_factor = c.get("min_theta_factor", p.min_theta_factor);
   p.coarsest_block_size = c.get("coarsest_block_size", p.coarsest_block_size);
+  p.probes = c.get("probes", p.probes);
   read_common(c, p.sigma, p.appearance, p.recovery);
   try {
     validate(p);
@@ -239,19 +250,13 @@ LevelStats level_stats(int level, const std::vector<Particle>& particles, int re
   return st;
 }
 
-// Loss bookkeeping shared by both trackers; returns whether the appearance may be updated.
-bool finish_state(TrackState& state, const Particle& map, const RecoveryParams& rec, double update_max_residual,
-                  double& search_factor) {
-  const bool was_lost = state.lost;
-  state.pose = map.pose;
-  state.confidence = std::clamp(1.0 - map.score.residual, 0.0, 1.0);
-  state.lost = map.score.residual > rec.lost_residual;
-  state.redetected = was_lost && !state.lost;
-  search_factor = state.lost ? std::min(search_factor * rec.growth, rec.max_factor) : 1.0;
-  if (!std::isfinite(state.pose.x) || !std::isfinite(state.pose.y) || !std::isfinite(state.pose.scale) ||
-      !std::isfinite(state.pose.theta))
+// The MAP particle becomes the estimate (eq. 3.6).
+void set_estimate(TrackState& state, const Particle& map) {
+  const auto& p = map.pose;
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.scale) || !std::isfinite(p.theta))
     throw std::runtime_error("ipsl: the estimated state is not finite");
-  return !state.lost && map.score.residual <= update_max_residual;
+  state.pose = p;
+  state.confidence = std::clamp(1.0 - map.score.residual, 0.0, 1.0);
 }
 
 size_t best_index(const std::vector<Particle>& particles) {
@@ -262,6 +267,23 @@ size_t best_index(const std::vector<Particle>& particles) {
 }
 
 }  // namespace
+
+bool LossMonitor::observe(double residual, double update_max_residual, TrackState& state) {
+  const bool was_lost = state.lost;
+  state.lost = residual > params_.lost_residual ||
+               (typical_ >= 0 && residual > params_.lost_ratio * typical_ && residual > params_.ratio_floor);
+  lost_frames_ = state.lost ? lost_frames_ + 1 : 0;
+  if (lost_frames_ > params_.max_lost_frames) {  // the appearance changed for good: learn it
+    state.lost = false;
+    lost_frames_ = 0;
+    typical_ = residual;
+  }
+  state.redetected = was_lost && !state.lost;
+  search_factor_ = state.lost ? std::min(search_factor_ * params_.growth, params_.max_factor) : 1.0;
+  if (state.lost) return false;
+  typical_ = typical_ < 0 ? residual : typical_ + params_.typical_rate * (residual - typical_);
+  return residual <= update_max_residual;
+}
 
 // ---------------------------------------------------------------------------------------------
 // IPSL (single resolution)
@@ -283,12 +305,12 @@ void IpslTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   state_.confidence = 1;
   build_pyramid(frame, sampling_octave(box.size(), 1, a.patch_size), pyramid_);
   model_ = std::make_unique<AppearanceModel>(a.patch_size * a.patch_size, a.max_basis, a.forgetting, a.block_size,
-                                             a.likelihood);
+                                             a.likelihood, a.anchor);
   particles_.assign(params_.particles, Particle{state_.pose, 0, {}});
   const Eigen::MatrixXf first = observe(pyramid_, static_cast<int>(pyramid_.size()) - 1, {particles_.front()},
                                         state_.initial_size, a.patch_size, a.normalize_patches);
   model_->init(first.col(0));
-  search_factor_ = 1;
+  loss_ = LossMonitor(params_.recovery);
   initialised_ = true;
 }
 
@@ -303,8 +325,8 @@ TrackState IpslTracker::update(const cv::Mat& frame) {
   for (size_t i = 0; i < particles_.size(); ++i) log_w[i] = particles_[i].score.log_likelihood;
   const auto parents = resample(log_w, params_.particles, rng_);
   MotionSigma sigma = params_.sigma;
-  sigma.x *= search_factor_;
-  sigma.y *= search_factor_;
+  sigma.x *= loss_.search_factor();
+  sigma.y *= loss_.search_factor();
   std::vector<Particle> next(parents.size());
   for (size_t i = 0; i < parents.size(); ++i) {
     next[i].pose = particles_[parents[i]].pose;
@@ -319,7 +341,8 @@ TrackState IpslTracker::update(const cv::Mat& frame) {
                                       a.normalize_patches);
   score_particles(*model_, obs, particles_);
   const size_t map = best_index(particles_);
-  if (finish_state(state_, particles_[map], params_.recovery, a.update_max_residual, search_factor_))
+  set_estimate(state_, particles_[map]);
+  if (loss_.observe(particles_[map].score.residual, a.update_max_residual, state_))
     model_->add(obs.col(static_cast<Eigen::Index>(map)));
   state_.levels = {level_stats(0, particles_, 0, sigma.x)};
   return state_;
@@ -360,10 +383,10 @@ void HierarchicalIpslTracker::init(const cv::Mat& frame, const cv::Rect2d& box) 
   for (int p = 0; p < n_levels; ++p) {
     const int patch = a.patch_size >> p;
     levels_.push_back(
-        std::make_unique<AppearanceModel>(patch * patch, a.max_basis, a.forgetting, block[p], a.likelihood));
+        std::make_unique<AppearanceModel>(patch * patch, a.max_basis, a.forgetting, block[p], a.likelihood, a.anchor));
     levels_[p]->init(observe(pyramid_, p + octave, at_init, box.size(), patch, a.normalize_patches).col(0));
   }
-  search_factor_ = 1;
+  loss_ = LossMonitor(params_.recovery);
   initialised_ = true;
 }
 
@@ -379,7 +402,7 @@ TrackState HierarchicalIpslTracker::update(const cv::Mat& frame) {
   auto estimates_rotation = [&](int p) { return p < coarsest || n_levels == 1; };
 
   // Search ranges at the level being processed, in that level's pixels (x, y) and radians.
-  double range_x = params_.sigma.x * search_factor_, range_y = params_.sigma.y * search_factor_;
+  double range_x = params_.sigma.x * loss_.search_factor(), range_y = params_.sigma.y * loss_.search_factor();
   double range_theta = estimates_rotation(coarsest) ? params_.sigma.theta : 0;
 
   // eq. 3.13: the last estimate seeds the coarsest level; particle 0 is the zero-motion hypothesis.
@@ -416,7 +439,8 @@ TrackState HierarchicalIpslTracker::update(const cv::Mat& frame) {
     if (p == 0) {  // the finest level: the MAP particle is the estimate (eq. 3.6)
       stats.push_back(level_stats(0, particles, 0, range_x));
       const auto map = static_cast<Eigen::Index>(order.front());
-      if (finish_state(state_, particles[map], params_.recovery, a.update_max_residual, search_factor_)) {
+      set_estimate(state_, particles[map]);
+      if (loss_.observe(particles[map].score.residual, a.update_max_residual, state_)) {
         levels_[0]->add(obs.col(map));
         const std::vector<Particle> estimate{particles[map]};
         for (int q = 1; q < n_levels; ++q)
@@ -453,9 +477,24 @@ TrackState HierarchicalIpslTracker::update(const cv::Mat& frame) {
 
     // eq. 3.12: the level's estimate (its MAP particle) seeds level p - 1, which draws as many
     // particles as survived the rejection, with that level's motion model and search range.
+    // Particle 0 is the estimate itself; with `probes`, particles 1 and 2 step only the
+    // parameter that no coarser level estimated (rotation where it enters, scale at level 0) by
+    // -/+ one sigma; the others take a full random step of the level's motion model.
     const MotionSigma s = step_sigma(p - 1);
     std::vector<Particle> next(n - rejected, Particle{best.pose, 0, {}});
-    for (size_t r = 1; r < next.size(); ++r) {
+    size_t first_random = 1;
+    if (params_.probes && next.size() >= 3) {
+      if (p - 1 == 0 && s.scale > 0) {
+        next[1].pose.scale *= std::exp(-s.scale);
+        next[2].pose.scale *= std::exp(s.scale);
+        first_random = 3;
+      } else if (!estimates_rotation(p) && s.theta > 0) {
+        next[1].pose.theta -= s.theta;
+        next[2].pose.theta += s.theta;
+        first_random = 3;
+      }
+    }
+    for (size_t r = first_random; r < next.size(); ++r) {
       random_walk(next[r].pose, s, rng_);
       clamp_pose(next[r].pose, frame_size_, state_.initial_size);
     }

@@ -29,19 +29,51 @@ struct AppearanceParams {
   int block_size = 5;          // N_B observations per incremental update
   double forgetting = 0.95;    // eta in (0, 1] (eqs. 3.3, 3.4)
   bool normalize_patches = true;  // zero-mean, unit-variance patches (illumination invariance)
+  // Every update block also holds the first observation: the subspace keeps the initial
+  // appearance (against drift; the similarity-normalised patch of a rigid target at the right
+  // pose always looks like it).
+  bool anchor = true;
   ObservationParams likelihood;
   // An observation enters the next update block only when its mean robust residual
   // (ObservationScore::residual) is below this (guards the subspace against occluders).
   double update_max_residual = 0.5;
 };
 
-// Loss detection and recovery: the target is declared lost when the MAP particle's mean robust
-// residual (ObservationScore::residual) exceeds `lost_residual`; while lost the subspace is not
-// updated and the search range grows by `growth` per frame, up to `max_factor` times sigma.
+// Loss detection and recovery. The target is declared lost when the MAP particle's mean robust
+// residual (ObservationScore::residual) exceeds `lost_residual`, or exceeds both `lost_ratio`
+// times its typical value (an exponential average, rate `typical_rate`, over the tracked
+// frames) and `ratio_floor` (so that tiny residuals of an easy target do not count); while
+// lost the subspace is not updated and the search range grows by `growth` per frame, up to
+// `max_factor` times sigma, until the target matches the frozen subspace again. After
+// `max_lost_frames` lost frames in a row the appearance is taken to have changed for good: the
+// tracker accepts its estimate and learns again.
 struct RecoveryParams {
-  double lost_residual = 0.6;
+  double lost_residual = 0.45;
+  double lost_ratio = 2.5;
+  double ratio_floor = 0.15;
+  double typical_rate = 0.05;
   double growth = 1.5;
   double max_factor = 6;
+  int max_lost_frames = 10;
+};
+
+// The loss bookkeeping of both trackers (RecoveryParams).
+class LossMonitor {
+ public:
+  explicit LossMonitor(const RecoveryParams& p = {}) : params_(p) {}
+  void reset() { *this = LossMonitor(params_); }
+  // Classifies a frame by its MAP residual: sets state.lost / state.redetected and the search
+  // factor; returns whether the appearance may learn from this frame (tracked and residual
+  // <= update_max_residual).
+  bool observe(double residual, double update_max_residual, TrackState& state);
+  double search_factor() const { return search_factor_; }
+  double typical_residual() const { return typical_; }
+
+ private:
+  RecoveryParams params_;
+  double typical_ = -1;  // < 0: no tracked frame yet
+  double search_factor_ = 1;
+  int lost_frames_ = 0;
 };
 
 struct IpslParams {
@@ -52,9 +84,11 @@ struct IpslParams {
 };
 
 struct HierarchicalIpslParams {
-  double min_size = 6;         // minSize of eq. 3.11: smallest target side at the coarsest level, px
+  // minSize of eq. 3.11, px: N_PL = floor(log2(min(T_W, T_H) / min_size)), so the target is at
+  // least 2 min_size pixels wide at the coarsest level.
+  double min_size = 2.5;
   int max_levels = 3;          // cap on N_PL
-  int particles = 100;         // N_P at the coarsest level; finer levels get the survivors
+  int particles = 65;          // N_P at the coarsest level; finer levels get the survivors
   double reject_ratio = 0.8;   // alpha of eq. 3.14: level p rejects floor(alpha^p * N_P^p)
   // Psi: x, y = translation step at the coarsest level (that level's pixels); theta = rotation
   // step at the level where rotation enters (1, or 0 with two levels); scale = log-scale step
@@ -66,6 +100,11 @@ struct HierarchicalIpslParams {
   double min_range = 0.3;
   double max_range = 1.0;
   double min_theta_factor = 0.2;
+  // Scale and rotation adaptation with few fine particles: two of the particles a level draws
+  // step only the parameter no coarser level estimated (rotation where it enters, scale at
+  // level 0) by -/+ sigma from the propagated estimate; the others take a random step in all
+  // the level's parameters.
+  bool probes = true;
   // N_B at the coarsest level; finer levels follow eq. 3.16 (at least 1).
   int coarsest_block_size = 8;
   AppearanceParams appearance;  // patch_size is the level-0 side; level p uses patch_size / 2^p
@@ -108,7 +147,7 @@ class IpslTracker : public Tracker {
   std::vector<cv::Mat> pyramid_;     // octaves of the frame, sampled without aliasing
   TrackState state_;
   cv::Size frame_size_;
-  double search_factor_ = 1;         // grows while the target is lost
+  LossMonitor loss_;
   bool initialised_ = false;
 };
 
@@ -136,7 +175,7 @@ class HierarchicalIpslTracker : public Tracker {
   std::vector<cv::Mat> pyramid_;
   TrackState state_;
   cv::Size frame_size_;
-  double search_factor_ = 1;
+  LossMonitor loss_;
   bool initialised_ = false;
 };
 

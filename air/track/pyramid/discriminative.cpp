@@ -62,8 +62,8 @@ DiscriminativeTracker::DiscriminativeTracker(std::string name, DiscriminativePar
   for (double r : p.reject_ratio) require(r >= 0 && r < 1, "reject_ratio values must be in [0, 1)");
   require(p.min_radius >= 1 && p.max_radius >= p.min_radius, "need 1 <= min_radius <= max_radius");
   require(p.scale_estimation == "none" || p.scale_estimation == "classifier" || p.scale_estimation == "flow" ||
-              p.scale_estimation == "hybrid" || p.scale_estimation == "both",
-          "scale_estimation must be none, classifier, flow, hybrid or both");
+              p.scale_estimation == "hybrid",
+          "scale_estimation must be none, flow, classifier or hybrid");
   require(p.scale_step > 1 && p.max_scale_change > 1, "scale_step and max_scale_change must be > 1");
   require(p.min_scale > 0 && p.max_scale > p.min_scale, "need 0 < min_scale < max_scale");
   require(p.lost_frames >= 1 && p.redetect_stride >= 1, "lost_frames and redetect_stride must be >= 1");
@@ -112,7 +112,7 @@ void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   }
   build_pyramid(frame, gray, {0, 0, gray.cols, gray.rows});
   learn();
-  previous_gray_ = gray.clone();
+  gray.copyTo(previous_gray_);
 }
 
 void DiscriminativeTracker::build_pyramid(const cv::Mat& frame, const cv::Mat& gray, const cv::Rect& roi) {
@@ -160,9 +160,8 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
       if (!grid.empty()) {
         L.classifier->score(L.ch, grid, scale_, scores);
         const size_t b = std::max_element(scores.begin(), scores.end()) - scores.begin();
-        out.prominence = prominence(scores, L.classifier->terms());
         c = centre_of(grid.positions()[b], box);
-        radius = stride + 0.5;
+        radius = std::max(radius, stride + 0.5);  // the usual disc around the best grid sample
         LevelStats scan_stats;
         scan_stats.level = p;
         scan_stats.evaluated = static_cast<int>(grid.size());
@@ -189,7 +188,7 @@ DiscriminativeTracker::Search DiscriminativeTracker::search(bool scan) {
     st.scores = scores;
 
     c = centre_of(l, box);
-    if (p == top && !scan) out.prominence = prominence(scores, L.classifier->terms());
+    if (p == top) out.prominence = prominence(scores, L.classifier->terms());  // same disc as when tracking
     if (p > 0) {
       // eq. 3.25: reject the xi^p N_S lowest-scoring samples; the best rejected one is the
       // critical sample and its distance to l^p the critical distance CD^p.
@@ -276,12 +275,14 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   TrackState state;
   state.initial_size = init_size_;
   scale_ = std::min(scale_, largest_scale());
+  // Scale candidates for the classifier to choose from (the first is searched).
   std::vector<double> scales = {scale_};
-  if (params_.scale_estimation == "classifier" || params_.scale_estimation == "both") {
+  const bool flow = params_.scale_estimation == "flow" || params_.scale_estimation == "hybrid";
+  if (params_.scale_estimation == "classifier") {
     scales.push_back(scale_ / params_.scale_step);
     scales.push_back(scale_ * params_.scale_step);
   }
-  if ((params_.scale_estimation == "flow" || params_.scale_estimation == "hybrid" || params_.scale_estimation == "both") && !lost_) {
+  if (flow && !lost_) {
     const cv::Size2d size = init_size_ * scale_;
     const FlowScale f = flow_scale(previous_gray_, gray,
                                    {centre_.x - size.width / 2, centre_.y - size.height / 2, size.width, size.height});
@@ -291,7 +292,7 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
       if (params_.scale_estimation == "flow") scales[0] = scale_ = s; else scales.push_back(s);
     }
   }
-  if (params_.scale_estimation != "none" && params_.scale_estimation != "classifier") previous_gray_ = gray.clone();
+  if (flow) gray.copyTo(previous_gray_);
   if (!lost_) {
     // Region that the search, the scale candidates and the training samples can reach.
     const int top = levels() - 1;
@@ -325,21 +326,27 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
     mean_prominence_ += rate * (z - mean_prominence_);
     learn();
   };
+  // Without confident frames the reference drifts slowly towards what is seen, so that a
+  // lasting change of appearance ends the freeze (and a loss) instead of making it permanent.
+  auto drift = [&] { mean_prominence_ += 0.25 * params_.confidence_rate * (z - mean_prominence_); };
 
   if (!lost_) {
     // Hysteresis: once below update_confidence, learning resumes only at found_confidence.
     const bool uncertain = low_frames_ > 0 ? conf < params_.found_confidence : conf < params_.update_confidence;
     low_frames_ = uncertain ? low_frames_ + 1 : 0;
-    if (low_frames_ == 0)
+    if (low_frames_ == 0) {
       confident_frame();
-    else if (params_.redetection && low_frames_ >= params_.lost_frames)
-      lost_ = true;
-  } else if (conf >= params_.found_confidence) {
+    } else {
+      drift();
+      if (params_.redetection && low_frames_ >= params_.lost_frames) lost_ = true;
+    }
+  } else if (conf >= params_.found_confidence) {  // lost, found again
     lost_ = false;
     low_frames_ = 0;
     state.redetected = true;
     confident_frame();
   } else {
+    drift();
     centre_ = previous;  // still lost: report where the target was last seen
     scale_ = previous_scale;
   }

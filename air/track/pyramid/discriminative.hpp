@@ -67,8 +67,9 @@ struct DiscriminativeParams {
   std::vector<double> reject_ratio = {0.9};  // xi^p for p = 1, 2, ... (last value repeats)
   double min_radius = 2.5;  // clamp of alpha^(p-1) = 2 CD^p, level pixels
   double max_radius = 12;
-  // Scale adaptation: "none", "classifier" (the final location re-scored at s / rho and
-  // s * rho, the best scale wins) or "flow" (Median Flow scale change of points in the box).
+  // Scale adaptation: "none", "flow" (Median Flow scale change of points in the box),
+  // "classifier" (the final location re-scored at s / rho and s * rho, the best scale wins) or
+  // "hybrid" (the classifier chooses between the current scale and the flow's).
   std::string scale_estimation = "flow";
   double scale_step = 1.05;      // rho
   double max_scale_change = 1.1; // per frame, flow

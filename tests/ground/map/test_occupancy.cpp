@@ -99,6 +99,7 @@ TEST(Occupancy, StereoErrorModelWeightsFarHitsAndKeepsFreeSpaceOffTheSurface) {
   params.stereo.focal_px = 260;
   params.stereo.baseline_m = 0.12;
   params.stereo.disparity_sigma_px = 0.5;
+  params.stereo.free_margin_sigmas = 2.0;
   m::OccupancyMap map(params);
   const Vector3f origin(0.05f, 0.05f, 0.05f);
   map.insert_frame({{1.05f, 0.05f, 0.05f}, {0.05f, 4.05f, 0.05f}}, origin);

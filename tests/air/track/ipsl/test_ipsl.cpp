@@ -166,21 +166,73 @@ TEST(HierarchicalIpsl, LevelCountsFollowEq314) {
   EXPECT_EQ(st.levels[0].evaluated, 100);
 }
 
+TEST(Ipsl, LossMonitorDetectsAndRecovers) {
+  RecoveryParams r;
+  r.lost_residual = 0.45;
+  r.lost_ratio = 2.5;
+  r.ratio_floor = 0.15;
+  r.typical_rate = 0.5;
+  r.growth = 2;
+  r.max_factor = 3;
+  r.max_lost_frames = 2;
+  LossMonitor m(r);
+  TrackState st;
+  EXPECT_TRUE(m.observe(0.1, 0.5, st));  // first tracked frame: typical = 0.1
+  EXPECT_FALSE(st.lost);
+  EXPECT_DOUBLE_EQ(m.typical_residual(), 0.1);
+  EXPECT_TRUE(m.observe(0.2, 0.5, st));  // 0.2 < 2.5 * 0.1: tracked, typical = 0.15
+  EXPECT_DOUBLE_EQ(m.typical_residual(), 0.15);
+  EXPECT_FALSE(m.observe(0.4, 0.5, st));  // 0.4 > 2.5 * 0.15 and > 0.15: lost, no learning
+  EXPECT_TRUE(st.lost);
+  EXPECT_DOUBLE_EQ(m.search_factor(), 2.0);
+  EXPECT_DOUBLE_EQ(m.typical_residual(), 0.15);  // frozen while lost
+  EXPECT_FALSE(m.observe(0.5, 0.5, st));          // > lost_residual
+  EXPECT_DOUBLE_EQ(m.search_factor(), 3.0);       // capped
+  EXPECT_FALSE(m.observe(0.2, 0.1, st));          // below 2.5 * 0.15: redetected; above update_max
+  EXPECT_FALSE(st.lost);
+  EXPECT_TRUE(st.redetected);
+  EXPECT_DOUBLE_EQ(m.search_factor(), 1.0);
+  EXPECT_TRUE(m.observe(0.3, 0.5, st));  // 0.3 < 2.5 * 0.175 and not a redetection any more
+  EXPECT_FALSE(st.redetected);
+  // Lost for more than max_lost_frames: the new appearance is accepted.
+  m.reset();
+  st = {};
+  EXPECT_TRUE(m.observe(0.05, 0.5, st));
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_FALSE(m.observe(0.44, 0.5, st));
+    EXPECT_TRUE(st.lost);
+  }
+  EXPECT_TRUE(m.observe(0.44, 0.5, st));
+  EXPECT_FALSE(st.lost);
+  EXPECT_DOUBLE_EQ(m.typical_residual(), 0.44);
+  // A tiny typical residual does not make small ones count as a loss (ratio_floor).
+  m.reset();
+  st = {};
+  m.observe(0.01, 0.5, st);
+  m.observe(0.1, 0.5, st);
+  EXPECT_FALSE(st.lost);
+}
+
 TEST(Ipsl, SubspaceIsUpdatedEveryBlock) {
-  IpslParams p;
-  p.appearance.block_size = 5;
-  IpslTracker t(p, 1);
-  const auto s = make_sequence(11, translation);
-  t.init(s.frames[0], s.init_box);
-  for (int k = 1; k <= 4; ++k) t.update(s.frames[k]);  // init + 4 observations = 1 block
-  EXPECT_NEAR(t.subspace().count(), 5, 1e-9);
-  EXPECT_EQ(t.subspace().rank(), 4);
-  for (int k = 5; k <= 9; ++k) t.update(s.frames[k]);
-  EXPECT_NEAR(t.subspace().count(), 0.95 * 5 + 5, 1e-9);
-  EXPECT_EQ(t.subspace().rank(), 9);
-  const TrackState st = t.update(s.frames[10]);
-  ASSERT_EQ(st.levels.size(), 1u);
-  EXPECT_EQ(st.levels[0].evaluated, p.particles);
+  for (const bool anchor : {false, true}) {
+    IpslParams p;
+    p.appearance.block_size = 5;
+    p.appearance.anchor = anchor;
+    IpslTracker t(p, 1);
+    const auto s = make_sequence(11, translation);
+    t.init(s.frames[0], s.init_box);
+    for (int k = 1; k <= 4; ++k) t.update(s.frames[k]);  // init + 4 observations = 1 block
+    EXPECT_NEAR(t.subspace().count(), 5, 1e-9);
+    EXPECT_EQ(t.subspace().rank(), 4);
+    for (int k = 5; k <= 9; ++k) t.update(s.frames[k]);
+    // eq. 3.4: n = eta n + m; the anchored block also holds the first observation.
+    const int m = anchor ? 6 : 5;
+    EXPECT_NEAR(t.subspace().count(), 0.95 * 5 + m, 1e-9);
+    EXPECT_EQ(t.subspace().rank(), 9);  // 10 distinct observations (the anchor repeats the first)
+    const TrackState st = t.update(s.frames[10]);
+    ASSERT_EQ(st.levels.size(), 1u);
+    EXPECT_EQ(st.levels[0].evaluated, p.particles);
+  }
 }
 
 TEST(Ipsl, DeterministicForASeed) {
