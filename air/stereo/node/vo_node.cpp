@@ -136,7 +136,7 @@ void VoNode::publish(const VoResult& r, int64_t seq, int64_t receive_utime) {
     case VoStatus::Reset: p.status = aerie::pose_t::RESET; break;
   }
   bus_.publish(cfg_.pose, p);
-  if (encoder_ && r.depth_computed) {
+  if (encoder_ && r.depth_computed && !r.disparity.empty()) {
     const spherical::SphericalDepth depth = encoder_->encode_disparity(r.disparity);
     bus_.publish(cfg_.depth, spherical::to_message(depth, r.utime, seq, r.T_world_cam));
     status_.count("depth_frames");

@@ -205,18 +205,26 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
     for (const auto& t : cur.tracks) r.features_3d += t.has_depth;
     cur.left = left.clone();
     prev_ = std::move(cur);
+    prev_utime_ = utime;
     make_keyframe(utime, *prev_);
     r.keyframe = true;
   } else {
     const Frame& prev = *prev_;
-    // 3. Matching, around the positions the previous motion predicts.
+    // 3. Matching, around the positions the previous motion predicts (constant velocity: the
+    //    last motion scaled to this frame interval, so dropped frames are bridged).
+    std::optional<geometry::SE3> prediction;
+    const int64_t dt = utime - prev_utime_;
+    if (last_motion_ && last_dt_ > 0 && dt > 0) {
+      const double scale = std::min(5.0, static_cast<double>(dt) / static_cast<double>(last_dt_));
+      prediction = geometry::SE3::exp(scale * last_motion_->log());
+    }
     std::vector<cv::Point2f> predicted;
-    if (last_motion_) {
-      const Eigen::Matrix3d R = last_motion_->rotation_matrix();
+    if (prediction) {
+      const Eigen::Matrix3d R = prediction->rotation_matrix();
       for (size_t i = 0; i < prev.tracks.size(); ++i) {
         const auto& f = prev.feats.features[i];
         Eigen::Vector3d X = prev.tracks[i].has_depth
-                                ? Eigen::Vector3d(*last_motion_ * prev.tracks[i].X)
+                                ? Eigen::Vector3d(*prediction * prev.tracks[i].X)
                                 : Eigen::Vector3d(R * Eigen::Vector3d((f.pt.x - cam_.cx) / cam_.fx,
                                                                       (f.pt.y - cam_.cy) / cam_.fy, 1.0));
         if (X.z() < 1e-3) X = Eigen::Vector3d((f.pt.x - cam_.cx) / cam_.fx, (f.pt.y - cam_.cy) / cam_.fy, 1.0);
@@ -225,9 +233,15 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
       }
     }
     MatchParams mp = params_.matching;
-    if (last_motion_) mp.search_radius = params_.predicted_search_radius;
+    if (prediction) mp.search_radius = params_.predicted_search_radius;
     auto matches = match_features(prev.feats.features, cur.feats.features, extractor_.descriptor_words(), mp,
-                                  last_motion_ ? &predicted : nullptr);
+                                  prediction ? &predicted : nullptr);
+    if (prediction && static_cast<int>(matches.size()) < 2 * params_.lost_min_inliers) {
+      // The motion changed abruptly: search again without the prediction.
+      matches = match_features(prev.feats.features, cur.feats.features, extractor_.descriptor_words(),
+                               params_.matching);
+      prediction.reset();
+    }
     if (params_.klt_window > 0 && !matches.empty()) {
       std::vector<cv::Point2f> from, to;
       for (const auto& m : matches) {
@@ -270,7 +284,7 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
     }
     r.features_3d = static_cast<int>(c3.size());
     r.features_2d = static_cast<int>(c2.size());
-    const MotionResult mr = motion_.estimate(cam_, c3, c2, last_motion_);
+    const MotionResult mr = motion_.estimate(cam_, c3, c2, prediction);
     r.timings.motion = sw.lap();
 
     if (!mr.ok || mr.inliers_3d < params_.lost_min_inliers) {
@@ -279,6 +293,7 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
       r.T_world_cam = T_world_cam_;
       r.T_odom_cam = T_odom_cam_;
       r.covariance = covariance_;
+      if (r.depth_computed) r.disparity = disparity;
       reset(r.message);
       r.timings.bookkeeping = sw.lap();
       return r;
@@ -288,6 +303,7 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
     r.inlier_ratio = matches.empty() ? 0.0 : static_cast<double>(r.inliers) / static_cast<double>(matches.size());
     r.motion = mr.T_next_k;
     last_motion_ = mr.T_next_k;
+    last_dt_ = dt;
     // T_odom_{k+1} = T_odom_k * M^-1; covariance to first order in the world frame.
     const geometry::SE3 Minv = mr.T_next_k.inverse();
     const Mat6 A = adjoint(T_odom_cam_) * adjoint(Minv);
@@ -341,6 +357,7 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
                       geometry::rotation_angle(since.rotation_matrix()) * 180.0 / M_PI > params_.keyframe_rotation_deg;
     cur.left = left.clone();
     prev_ = std::move(cur);
+    prev_utime_ = utime;
     if (want && (depth_frame || refine)) {
       make_keyframe(utime, *prev_);
       r.keyframe = true;

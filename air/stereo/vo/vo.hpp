@@ -140,7 +140,8 @@ class StereoOdometry {
   int64_t frame_count_ = 0, next_track_ = 0, keyframe_count_ = 0;
   geometry::SE3 T_odom_cam_, T_world_cam_;
   Eigen::Matrix<double, 6, 6> covariance_ = Eigen::Matrix<double, 6, 6>::Zero();
-  std::optional<geometry::SE3> last_motion_;
+  std::optional<geometry::SE3> last_motion_;  // T_cur_prev of the last step
+  int64_t last_dt_ = 0, prev_utime_ = 0;     // its frame interval, the previous frame's time
   bool restarted_ = false;
   std::string restart_reason_;
   // Keyframes: odometry pose of the last one and which tracks it had; BA anchors.
