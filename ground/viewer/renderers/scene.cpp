@@ -5,11 +5,8 @@
 #include <vtkAxesActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
-#include <vtkCubeSource.h>
 #include <vtkFloatArray.h>
-#include <vtkGlyph3DMapper.h>
 #include <vtkLookupTable.h>
-#include <vtkCellData.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -23,6 +20,7 @@
 
 #include "common/spherical/spherical_message.hpp"
 #include "ground/viewer/layout.hpp"
+#include "ground/viewer/voxel_mesh.hpp"
 
 namespace aerie::viewer {
 namespace {
@@ -64,6 +62,7 @@ GridRenderer::GridRenderer(double half_size_m, double spacing_m)
     : Renderer("grid"), half_(half_size_m), spacing_(spacing_m) {}
 
 void GridRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   grid_ = line_actor(0.45, 0.45, 0.5, 1);
   auto pts = vtkSmartPointer<vtkPoints>::New();
   auto lines = vtkSmartPointer<vtkCellArray>::New();
@@ -113,6 +112,7 @@ void PoseRenderer::subscribe(bus::Bus& bus) {
 }
 
 void PoseRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   // Ground truth in green, the estimate in orange.
   const double r = gt_ ? 0.2 : 1.0, g = gt_ ? 0.9 : 0.55, b = gt_ ? 0.3 : 0.1;
   path_ = line_actor(r, g, b, 2);
@@ -170,6 +170,7 @@ void DepthCloudRenderer::subscribe(bus::Bus& bus) {
 }
 
 void DepthCloudRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   actor_ = line_actor(0.3, 0.9, 1.0, 1);
   actor_->GetProperty()->SetPointSize(2);
   layout.scene->AddActor(actor_);
@@ -247,9 +248,11 @@ void OctomapRenderer::subscribe(bus::Bus& bus) {
 }
 
 void OctomapRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
   mapper->SetInputData(vtkSmartPointer<vtkPolyData>::New());
-  mapper->SetScalarModeToUseCellData();
+  mapper->SetScalarModeToUsePointData();
+  mapper->InterpolateScalarsBeforeMappingOn();  // height colours per pixel, not per corner
   mapper->ScalarVisibilityOn();
   auto lut = vtkSmartPointer<vtkLookupTable>::New();
   lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
@@ -257,6 +260,7 @@ void OctomapRenderer::attach(Layout& layout) {
   mapper->SetLookupTable(lut);
   actor_ = vtkSmartPointer<vtkActor>::New();
   actor_->SetMapper(mapper);
+  actor_->GetProperty()->BackfaceCullingOn();  // the quads face out of the occupied space
   layout.scene->AddActor(actor_);
 }
 
@@ -282,61 +286,47 @@ bool OctomapRenderer::update() {
   return true;
 }
 
-// Occupied voxels as one mesh of their visible faces: a face shared with another
-// occupied voxel is never seen and is left out, which keeps a 100k-voxel map to a few
-// hundred thousand triangles that software OpenGL draws at display rate.
+// Occupied voxels as the merged quads of their visible surface (voxel_mesh.hpp),
+// coloured by height: the corners carry their z, interpolated across each quad.
 void OctomapRenderer::extract() {
-  auto points = vtkSmartPointer<vtkPoints>::New();
-  points->SetDataTypeToFloat();
-  auto quads = vtkSmartPointer<vtkCellArray>::New();
-  auto height = vtkSmartPointer<vtkFloatArray>::New();
-  height->SetName("height");
+  VoxelMesh mesh;
   double zmin = 0, zmax = 1;
-  size_t voxels = 0;
   {
     std::lock_guard lock(map_->m);
     if (!map_->tree) return;
-    auto& tree = *map_->tree;
-    const unsigned depth = tree.getTreeDepth() - static_cast<unsigned>(coarsening_);
     double lo[3], hi[3];
-    tree.getMetricMin(lo[0], lo[1], lo[2]);
-    tree.getMetricMax(hi[0], hi[1], hi[2]);
+    map_->tree->getMetricMin(lo[0], lo[1], lo[2]);
+    map_->tree->getMetricMax(hi[0], hi[1], hi[2]);
     zmin = lo[2];
     zmax = std::max(hi[2], zmin + 1e-3);
-    static const int dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    for (auto it = tree.begin_leafs(depth); it != tree.end_leafs(); ++it) {
-      if (!tree.isNodeOccupied(*it)) continue;
-      ++voxels;
-      const auto c = it.getCoordinate();
-      const float h = static_cast<float>(it.getSize() / 2);
-      for (const auto& d : dirs) {
-        const octomap::point3d n(c.x() + d[0] * (h + 1e-3f), c.y() + d[1] * (h + 1e-3f), c.z() + d[2] * (h + 1e-3f));
-        const auto* nb = tree.search(n, depth);
-        if (nb && tree.isNodeOccupied(nb)) continue;  // hidden face
-        // The face's four corners: the two axes orthogonal to d span it.
-        const int a = d[0] ? 1 : 0, b = d[2] ? 1 : 2;
-        vtkIdType ids[4];
-        const float s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-        for (int k = 0; k < 4; ++k) {
-          float p[3] = {c.x(), c.y(), c.z()};
-          for (int axis = 0; axis < 3; ++axis) p[axis] += d[axis] * h;
-          p[a] += s[k][0] * h;
-          p[b] += s[k][1] * h;
-          ids[k] = points->InsertNextPoint(p);
-        }
-        quads->InsertNextCell(4, ids);
-        height->InsertNextValue(c.z());
-      }
-    }
+    mesh = mesh_occupied_surface(*map_->tree, coarsening_);
+  }
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  points->SetDataTypeToFloat();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
+  auto height = vtkSmartPointer<vtkFloatArray>::New();
+  height->SetName("height");
+  height->SetNumberOfValues(static_cast<vtkIdType>(mesh.points.size()));
+  for (vtkIdType i = 0; i < static_cast<vtkIdType>(mesh.points.size()); ++i) {
+    const auto& p = mesh.points[static_cast<size_t>(i)];
+    points->SetPoint(i, p.data());
+    height->SetValue(i, p[2]);
+  }
+  auto quads = vtkSmartPointer<vtkCellArray>::New();
+  quads->AllocateExact(static_cast<vtkIdType>(mesh.quads.size()), static_cast<vtkIdType>(4 * mesh.quads.size()));
+  for (const auto& q : mesh.quads) {
+    const vtkIdType ids[4] = {q[0], q[1], q[2], q[3]};
+    quads->InsertNextCell(4, ids);
   }
   auto poly = vtkSmartPointer<vtkPolyData>::New();
   poly->SetPoints(points);
   poly->SetPolys(quads);
-  poly->GetCellData()->SetScalars(height);
+  poly->GetPointData()->SetScalars(height);
   auto* mapper = vtkPolyDataMapper::SafeDownCast(actor_->GetMapper());
   mapper->SetInputData(poly);
   mapper->SetScalarRange(zmin, zmax);
-  shown_ = voxels;
+  shown_ = mesh.voxels;
+  quads_ = mesh.quads.size();
 }
 
 void OctomapRenderer::on_enabled(bool on) {
@@ -362,6 +352,7 @@ void TargetPoseRenderer::subscribe(bus::Bus& bus) {
 }
 
 void TargetPoseRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   auto sphere = vtkSmartPointer<vtkSphereSource>::New();
   sphere->SetRadius(0.15);
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();

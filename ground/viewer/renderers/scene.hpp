@@ -84,7 +84,7 @@ class DepthCloudRenderer : public Renderer {
   std::string channel_;
   Latest<std::vector<Eigen::Vector3f>> cloud_;
   uint64_t seen_ = 0;
-  size_t shown_ = 0;
+  size_t shown_ = 0, quads_ = 0;
   vtkSmartPointer<vtkActor> actor_;
 };
 
@@ -102,12 +102,12 @@ class OctomapRenderer : public Renderer {
   void set_coarsening(int levels);
   int coarsening() const { return coarsening_; }
   size_t voxels_shown() const { return shown_; }
+  size_t quads_shown() const { return quads_; }
 
  protected:
   void on_enabled(bool on) override;
 
  private:
-  struct Voxels;
   struct Map;
   void extract();
 
@@ -116,7 +116,7 @@ class OctomapRenderer : public Renderer {
   uint64_t seen_ = 0;
   int coarsening_ = 0;
   bool dirty_ = false;
-  size_t shown_ = 0;
+  size_t shown_ = 0, quads_ = 0;
   vtkSmartPointer<vtkActor> actor_;
 };
 
