@@ -71,6 +71,19 @@ struct Fixture : ::testing::Test {
     return {cvRound(d.x), viewer->layout().window->GetSize()[1] - 1 - cvRound(d.y)};
   }
   void publish_image(int64_t utime, uchar value = 90) { publish_image_on(bus, utime, value); }
+  void publish_map(octomap::OcTree& tree, int64_t utime) {
+    std::ostringstream out;
+    tree.writeBinary(out);
+    const std::string bytes = out.str();
+    aerie::octomap_t m{};
+    m.utime = utime;
+    m.resolution = tree.getResolution();
+    m.binary = true;
+    m.full = true;
+    m.data.assign(bytes.begin(), bytes.end());
+    m.length = static_cast<int32_t>(m.data.size());
+    bus.publish("MAP_OCTOMAP", m);
+  }
   static void publish_image_on(bus::Bus& b, int64_t utime, uchar value = 90) {
     b.publish("CAM_LEFT", image::to_message(cv::Mat(240, 320, CV_8UC1, cv::Scalar(value)), utime, utime));
   }
@@ -200,17 +213,7 @@ TEST_F(Fixture, OctomapVoxelsAppearWhereTheMapHasThem) {
       tree.updateNode(octomap::point3d(2.1f + 0.2f * i, -0.5f + 0.2f * j, 1.1f), true);
       ++expected;
     }
-  std::ostringstream out;
-  tree.writeBinary(out);
-  const std::string bytes = out.str();
-  aerie::octomap_t m{};
-  m.utime = 5;
-  m.resolution = 0.2;
-  m.binary = true;
-  m.full = true;
-  m.data.assign(bytes.begin(), bytes.end());
-  m.length = static_cast<int32_t>(m.data.size());
-  bus.publish("MAP_OCTOMAP", m);
+  publish_map(tree, 5);
   auto* oct = dynamic_cast<OctomapRenderer*>(viewer->find("octomap"));
   ASSERT_NE(oct, nullptr);
   ASSERT_TRUE(render_until([&] { return oct->voxels_shown() > 0; }));
@@ -240,16 +243,7 @@ TEST_F(Fixture, UnchangedPanesKeepTheirPixelsAndAreNotRedrawn) {
   make(800, 500);
   octomap::OcTree tree(0.2);
   for (int i = 0; i < 6; ++i) tree.updateNode(octomap::point3d(0.1f + 0.2f * i, 0.1f, 0.1f), true);
-  std::ostringstream out;
-  tree.writeBinary(out);
-  const std::string bytes = out.str();
-  aerie::octomap_t m{};
-  m.resolution = 0.2;
-  m.binary = true;
-  m.full = true;
-  m.data.assign(bytes.begin(), bytes.end());
-  m.length = static_cast<int32_t>(m.data.size());
-  bus.publish("MAP_OCTOMAP", m);
+  publish_map(tree, 1);
   publish_image(1, 40);
   auto* oct = dynamic_cast<OctomapRenderer*>(viewer->find("octomap"));
   ASSERT_TRUE(render_until([&] { return oct->voxels_shown() > 0 && !viewer->image_pane().image_size().empty(); }));
