@@ -49,11 +49,20 @@ int main(int argc, char** argv) {
                  "1-4 voxels (a face between almost every pair of columns, worst case)")
       ->check(CLI::IsMember({"floor", "rough"}))
       ->capture_default_str();
+  std::string map_file, snapshot;
+  app.add_option("--snapshot", snapshot, "write a PNG of the window at the end");
+  app.add_option("--map-file", map_file, "a saved map (.bt/.ot, e.g. the demo flight's) instead of --map/--voxels")
+      ->check(CLI::ExistingFile);
   bool poses = false;
+  int coarsening = 0;
+  app.add_option("--coarsening", coarsening, "display the map this many levels coarser (the viewer's 'v' key)")
+      ->capture_default_str();
   app.add_flag("--poses", poses, "also publish a VO_POSE with every stereo frame (the 3D scene changes at 20 Hz)");
   app.add_flag("--always-redraw", opts.always_redraw, "draw every pane every frame, free-running");
   app.add_option("--multisamples", opts.multisamples, "OpenGL multisampling")->capture_default_str();
   app.add_option("--pane-fps", opts.pane_fps, "redraw rate limit of the non-camera panes")->capture_default_str();
+  app.add_option("--map-max-quads", opts.map_max_quads, "quad budget of the map display (0: none)")
+      ->capture_default_str();
   app.add_option("--out", out, "JSON result file");
   CLI11_PARSE(app, argc, argv);
 
@@ -64,29 +73,45 @@ int main(int argc, char** argv) {
   v.add_default_renderers();
   v.start();
 
-  // A map of `voxels` occupied 0.1 m voxels.
-  octomap::OcTree tree(0.1);
+  // A map of `voxels` occupied 0.1 m voxels, or a saved one.
+  auto tree_ptr = std::make_unique<octomap::OcTree>(0.1);
   std::mt19937 rng(1);
-  if (map_kind == "floor") {  // one layer of a 30 m square, then a second layer
+  if (!map_file.empty()) {
+    if (map_file.size() > 3 && map_file.substr(map_file.size() - 3) == ".ot") {
+      std::unique_ptr<octomap::AbstractOcTree> saved(octomap::AbstractOcTree::read(map_file));
+      if (auto* t = dynamic_cast<octomap::OcTree*>(saved.get())) {
+        saved.release();
+        tree_ptr.reset(t);
+      }
+    } else if (!tree_ptr->readBinary(map_file)) {
+      tree_ptr.reset();
+    }
+    if (!tree_ptr) {
+      std::cerr << "bench_viewer: " << map_file << " is not an OctoMap OcTree\n";
+      return 2;
+    }
+    map_kind = map_file;
+  } else if (map_kind == "floor") {  // one layer of a 30 m square, then a second layer
     for (int i = 0; i < voxels; ++i) {
       const float x = 0.05f + 0.1f * (i % 300), y = 0.05f + 0.1f * ((i / 300) % 300), z = 0.05f + 0.1f * (i / 90000);
-      tree.updateNode(octomap::point3d(x - 15, y - 15, z), true, true);
+      tree_ptr->updateNode(octomap::point3d(x - 15, y - 15, z), true, true);
     }
   } else {  // columns 1..4 voxels high, side chosen for `voxels` in all (mean height 2.5)
     const int side = static_cast<int>(std::ceil(std::sqrt(voxels / 2.5)));
     std::uniform_int_distribution<int> height(1, 4);
     for (int n = 0, i = 0; n < voxels; ++i)
       for (int h = height(rng); h > 0 && n < voxels; --h, ++n)
-        tree.updateNode(octomap::point3d(0.1f * (i % side - side / 2) + 0.05f, 0.1f * (i / side - side / 2) + 0.05f,
-                                         0.1f * h - 0.05f),
-                        true, true);
+        tree_ptr->updateNode(octomap::point3d(0.1f * (i % side - side / 2) + 0.05f, 0.1f * (i / side - side / 2) + 0.05f,
+                                              0.1f * h - 0.05f),
+                             true, true);
   }
+  octomap::OcTree& tree = *tree_ptr;
   tree.updateInnerOccupancy();
   std::ostringstream os;
   tree.writeBinary(os);
   const std::string bytes = os.str();
   aerie::octomap_t map{};
-  map.resolution = 0.1;
+  map.resolution = tree.getResolution();
   map.binary = true;
   map.full = true;
   map.data.assign(bytes.begin(), bytes.end());
@@ -102,7 +127,7 @@ int main(int argc, char** argv) {
     auto next = std::chrono::steady_clock::now();
     for (int64_t k = 0; run; ++k) {
       aerie::stereo_image_t s{};
-      s.utime = k * 50000;
+      s.utime = util::wall_utime();  // the latency chart shows the real delivery delay
       s.seq = k;
       s.left = image::to_message(left, s.utime, k);
       s.right = image::to_message(right, s.utime, k);
@@ -126,6 +151,7 @@ int main(int argc, char** argv) {
   });
 
   auto* oct = dynamic_cast<viewer::OctomapRenderer*>(v.find("octomap"));
+  oct->set_coarsening(coarsening);
   while (voxels > 0 && oct->voxels_shown() == 0) v.render_frame();  // map loaded and uploaded
   // Frames in which the camera pane and the 3D scene were drawn (VTK's StartEvent of each pane).
   int64_t image_draws = 0, scene_draws = 0;
@@ -145,13 +171,14 @@ int main(int argc, char** argv) {
     if (v.frames_rendered() == before) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   const double wall = util::mono_ms() / 1000 - t0, cpu = cpu_seconds(RUSAGE_SELF) - cpu0;
+  if (!snapshot.empty()) v.snapshot(snapshot);
   run = false;
   camera.join();
   v.stop();
   const double fps = (v.frames_rendered() - frames0) / wall;
   std::ostringstream json;
   json << "{\"map\": \"" << map_kind << "\", \"poses\": " << poses << ", \"voxels_shown\": " << oct->voxels_shown()
-       << ", \"quads_shown\": " << oct->quads_shown() << ", \"always_redraw\": " << opts.always_redraw
+       << ", \"quads_shown\": " << oct->quads_shown() << ", \"coarsening_shown\": " << oct->coarsening_shown() << ", \"always_redraw\": " << opts.always_redraw
        << ", \"multisamples\": " << opts.multisamples << ", \"seconds\": " << wall << ", \"display_fps\": " << fps
        << ", \"camera_fps\": " << (published - published0) / wall << ", \"camera_pane_fps\": " << image_draws / wall
        << ", \"scene_fps\": " << scene_draws / wall

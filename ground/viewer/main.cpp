@@ -48,6 +48,9 @@ int main(int argc, char** argv) {
                  "at most this many redraws per second of the 3D scene, charts and panel (when they change)")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 200.0));
+  app.add_option("--map-max-quads", opts.map_max_quads,
+                 "show the OctoMap one level coarser while its surface needs more quads than this (0: no limit)")
+      ->capture_default_str();
   app.add_option("--multisamples", opts.multisamples, "OpenGL anti-aliasing samples (0: off, best without a GPU)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));

@@ -61,7 +61,7 @@ void Viewer::add_default_renderers() {
   add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false));
   add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true));
   add(std::make_unique<DepthCloudRenderer>());
-  add(std::make_unique<OctomapRenderer>());
+  add(std::make_unique<OctomapRenderer>("MAP_OCTOMAP", options_.map_max_quads));
   add(std::make_unique<TargetPoseRenderer>());
   add_default_charts(*this);
   add(std::make_unique<ProcmanPanel>());

@@ -14,7 +14,9 @@
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
+#include <vtkTextProperty.h>
 
+#include <cstdio>
 #include <mutex>
 #include <sstream>
 
@@ -206,8 +208,8 @@ struct OctomapRenderer::Map {
   uint64_t version = 0;
 };
 
-OctomapRenderer::OctomapRenderer(std::string channel)
-    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()) {}
+OctomapRenderer::OctomapRenderer(std::string channel, size_t max_quads)
+    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()), max_quads_(max_quads) {}
 OctomapRenderer::~OctomapRenderer() = default;
 
 namespace {
@@ -262,6 +264,16 @@ void OctomapRenderer::attach(Layout& layout) {
   actor_->SetMapper(mapper);
   actor_->GetProperty()->BackfaceCullingOn();  // the quads face out of the occupied space
   layout.scene->AddActor(actor_);
+  label_ = vtkSmartPointer<vtkTextActor>::New();
+  label_->GetTextProperty()->SetFontSize(12);
+  label_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
+  label_->SetPosition(6, 6);
+  layout.scene->AddActor2D(label_);
+}
+
+void OctomapRenderer::set_max_quads(size_t n) {
+  max_quads_ = n;
+  dirty_ = true;
 }
 
 void OctomapRenderer::set_coarsening(int levels) {
@@ -290,7 +302,7 @@ bool OctomapRenderer::update() {
 // coloured by height: the corners carry their z, interpolated across each quad.
 void OctomapRenderer::extract() {
   VoxelMesh mesh;
-  double zmin = 0, zmax = 1;
+  double zmin = 0, zmax = 1, resolution = 0;
   {
     std::lock_guard lock(map_->m);
     if (!map_->tree) return;
@@ -299,7 +311,11 @@ void OctomapRenderer::extract() {
     map_->tree->getMetricMax(hi[0], hi[1], hi[2]);
     zmin = lo[2];
     zmax = std::max(hi[2], zmin + 1e-3);
-    mesh = mesh_occupied_surface(*map_->tree, coarsening_);
+    shown_coarsening_ = coarsening_;
+    mesh = mesh_occupied_surface(*map_->tree, shown_coarsening_);
+    while (max_quads_ > 0 && mesh.quads.size() > max_quads_ && shown_coarsening_ < 4)
+      mesh = mesh_occupied_surface(*map_->tree, ++shown_coarsening_);
+    resolution = map_->tree->getNodeSize(map_->tree->getTreeDepth() - static_cast<unsigned>(shown_coarsening_));
   }
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToFloat();
@@ -327,10 +343,15 @@ void OctomapRenderer::extract() {
   mapper->SetScalarRange(zmin, zmax);
   shown_ = mesh.voxels;
   quads_ = mesh.quads.size();
+  char text[128];
+  std::snprintf(text, sizeof(text), "map: %zu voxels of %.2f m%s", shown_, resolution,
+                shown_coarsening_ > coarsening_ ? " (coarser: quad budget)" : "");
+  label_->SetInput(text);
 }
 
 void OctomapRenderer::on_enabled(bool on) {
   if (actor_) actor_->SetVisibility(on);
+  if (label_) label_->SetVisibility(on);
 }
 
 // ---------------------------------------------------------------- target
