@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   app.add_option("--map-file", map_file, "a saved map (.bt/.ot, e.g. the demo flight's) instead of --map/--voxels")
       ->check(CLI::ExistingFile);
   bool poses = false;
+  double map_period = 1.0;
+  app.add_option("--map-period", map_period,
+                 "seconds between full MAP_OCTOMAP messages (aerie-map's default publish period; 0: once)")
+      ->capture_default_str();
   int coarsening = 0;
   app.add_option("--coarsening", coarsening, "display the map this many levels coarser (the viewer's 'v' key)")
       ->capture_default_str();
@@ -132,6 +136,10 @@ int main(int argc, char** argv) {
       s.left = image::to_message(left, s.utime, k);
       s.right = image::to_message(right, s.utime, k);
       bus.publish("CAM_STEREO", s);
+      if (map_period > 0 && k > 0 && k % std::max<int64_t>(1, std::llround(map_period * 20)) == 0) {
+        map.utime = s.utime;
+        bus.publish("MAP_OCTOMAP", map);
+      }
       if (poses) {  // a 2 m circle at 1.5 m height
         aerie::pose_t p{};
         p.utime = s.utime;
@@ -179,7 +187,7 @@ int main(int argc, char** argv) {
   std::ostringstream json;
   json << "{\"map\": \"" << map_kind << "\", \"poses\": " << poses << ", \"voxels_shown\": " << oct->voxels_shown()
        << ", \"quads_shown\": " << oct->quads_shown() << ", \"coarsening_shown\": " << oct->coarsening_shown() << ", \"always_redraw\": " << opts.always_redraw
-       << ", \"multisamples\": " << opts.multisamples << ", \"seconds\": " << wall << ", \"display_fps\": " << fps
+       << ", \"map_period_s\": " << map_period << ", \"multisamples\": " << opts.multisamples << ", \"seconds\": " << wall << ", \"display_fps\": " << fps
        << ", \"camera_fps\": " << (published - published0) / wall << ", \"camera_pane_fps\": " << image_draws / wall
        << ", \"scene_fps\": " << scene_draws / wall
        << ", \"cpu_percent_of_one_core\": " << 100 * cpu / wall

@@ -17,7 +17,11 @@
 #include <vtkTextProperty.h>
 
 #include <cstdio>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
+#include <optional>
+#include <thread>
 #include <sstream>
 
 #include "common/spherical/spherical_message.hpp"
@@ -202,15 +206,83 @@ void DepthCloudRenderer::on_enabled(bool on) {
 }
 
 // ---------------------------------------------------------------- octomap
+// The map is merged and meshed by a thread of its own, so that neither the LCM thread
+// nor the render thread waits for a large map (100k voxels take ~100 ms to mesh).
 struct OctomapRenderer::Map {
+  struct Surface {
+    VoxelMesh mesh;
+    double zmin = 0, zmax = 1, resolution = 0;
+    int coarsening_shown = 0;
+  };
   std::mutex m;
-  std::unique_ptr<octomap::OcTree> tree;
-  uint64_t version = 0;
+  std::condition_variable wake;
+  std::deque<std::pair<std::unique_ptr<octomap::OcTree>, bool>> inbox;  // parsed messages, full?
+  int coarsening = 0;
+  size_t max_quads = 0;
+  uint64_t settings = 1;  // bumped when coarsening or max_quads change
+  bool stop = false;
+  std::optional<Surface> ready;  // the newest surface, until the render thread takes it
+  std::thread mesher;
+
+  void run();
 };
 
+void OctomapRenderer::Map::run() {
+  std::unique_ptr<octomap::OcTree> tree;
+  uint64_t meshed_settings = 0;
+  for (;;) {
+    std::deque<std::pair<std::unique_ptr<octomap::OcTree>, bool>> messages;
+    int levels = 0;
+    size_t budget = 0;
+    {
+      std::unique_lock lock(m);
+      wake.wait(lock, [&] { return stop || !inbox.empty() || settings != meshed_settings; });
+      if (stop) return;
+      messages.swap(inbox);
+      levels = coarsening;
+      budget = max_quads;
+      meshed_settings = settings;
+    }
+    for (auto& [incoming, full] : messages) {
+      if (full || !tree || tree->getResolution() != incoming->getResolution()) {
+        tree = std::move(incoming);
+      } else {
+        // A changed region: its leaves (occupied and free) overwrite the local copy.
+        for (auto it = incoming->begin_leafs(); it != incoming->end_leafs(); ++it)
+          tree->setNodeValue(it.getCoordinate(), it->getLogOdds(), true);
+      }
+    }
+    if (!tree) continue;
+    Surface s;
+    double lo[3], hi[3];
+    tree->getMetricMin(lo[0], lo[1], lo[2]);
+    tree->getMetricMax(hi[0], hi[1], hi[2]);
+    s.zmin = lo[2];
+    s.zmax = std::max(hi[2], s.zmin + 1e-3);
+    s.coarsening_shown = levels;
+    s.mesh = mesh_occupied_surface(*tree, levels);
+    while (budget > 0 && s.mesh.quads.size() > budget && s.coarsening_shown < 4)
+      s.mesh = mesh_occupied_surface(*tree, ++s.coarsening_shown);
+    s.resolution = tree->getNodeSize(tree->getTreeDepth() - static_cast<unsigned>(s.coarsening_shown));
+    std::lock_guard lock(m);
+    ready = std::move(s);
+  }
+}
+
 OctomapRenderer::OctomapRenderer(std::string channel, size_t max_quads)
-    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()), max_quads_(max_quads) {}
-OctomapRenderer::~OctomapRenderer() = default;
+    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()) {
+  map_->max_quads = max_quads;
+  map_->mesher = std::thread([this] { map_->run(); });
+}
+
+OctomapRenderer::~OctomapRenderer() {
+  {
+    std::lock_guard lock(map_->m);
+    map_->stop = true;
+  }
+  map_->wake.notify_all();
+  map_->mesher.join();
+}
 
 namespace {
 std::unique_ptr<octomap::OcTree> parse_octree(const aerie::octomap_t& m) {
@@ -235,16 +307,12 @@ void OctomapRenderer::subscribe(bus::Bus& bus) {
   bus.subscribe<aerie::octomap_t>(
       channel_,
       [this](const aerie::octomap_t& m, const bus::ReceiveInfo&) {
-        auto incoming = parse_octree(m);  // parse outside the lock
-        std::lock_guard lock(map_->m);
-        if (m.full || !map_->tree || map_->tree->getResolution() != incoming->getResolution()) {
-          map_->tree = std::move(incoming);
-        } else {
-          // A changed region: its leaves (occupied and free) overwrite the local copy.
-          for (auto it = incoming->begin_leafs(); it != incoming->end_leafs(); ++it)
-            map_->tree->setNodeValue(it.getCoordinate(), it->getLogOdds(), true);
+        auto incoming = parse_octree(m);  // a malformed message throws here and is counted
+        {
+          std::lock_guard lock(map_->m);
+          map_->inbox.emplace_back(std::move(incoming), m.full);
         }
-        ++map_->version;
+        map_->wake.notify_one();
       },
       4);
 }
@@ -272,13 +340,22 @@ void OctomapRenderer::attach(Layout& layout) {
 }
 
 void OctomapRenderer::set_max_quads(size_t n) {
-  max_quads_ = n;
-  dirty_ = true;
+  {
+    std::lock_guard lock(map_->m);
+    map_->max_quads = n;
+    ++map_->settings;
+  }
+  map_->wake.notify_one();
 }
 
 void OctomapRenderer::set_coarsening(int levels) {
   coarsening_ = std::clamp(levels, 0, 4);
-  dirty_ = true;
+  {
+    std::lock_guard lock(map_->m);
+    map_->coarsening = coarsening_;
+    ++map_->settings;
+  }
+  map_->wake.notify_one();
 }
 
 bool OctomapRenderer::on_key(const std::string& key) {
@@ -287,36 +364,16 @@ bool OctomapRenderer::on_key(const std::string& key) {
   return true;
 }
 
+// The mesher's newest surface (voxel_mesh.hpp) to VTK, coloured by height: the corners
+// carry their z, interpolated across each quad.
 bool OctomapRenderer::update() {
+  std::optional<Map::Surface> surface;
   {
     std::lock_guard lock(map_->m);
-    if (map_->version == seen_ && !dirty_) return false;
-    seen_ = map_->version;
+    surface.swap(map_->ready);
   }
-  dirty_ = false;
-  extract();
-  return true;
-}
-
-// Occupied voxels as the merged quads of their visible surface (voxel_mesh.hpp),
-// coloured by height: the corners carry their z, interpolated across each quad.
-void OctomapRenderer::extract() {
-  VoxelMesh mesh;
-  double zmin = 0, zmax = 1, resolution = 0;
-  {
-    std::lock_guard lock(map_->m);
-    if (!map_->tree) return;
-    double lo[3], hi[3];
-    map_->tree->getMetricMin(lo[0], lo[1], lo[2]);
-    map_->tree->getMetricMax(hi[0], hi[1], hi[2]);
-    zmin = lo[2];
-    zmax = std::max(hi[2], zmin + 1e-3);
-    shown_coarsening_ = coarsening_;
-    mesh = mesh_occupied_surface(*map_->tree, shown_coarsening_);
-    while (max_quads_ > 0 && mesh.quads.size() > max_quads_ && shown_coarsening_ < 4)
-      mesh = mesh_occupied_surface(*map_->tree, ++shown_coarsening_);
-    resolution = map_->tree->getNodeSize(map_->tree->getTreeDepth() - static_cast<unsigned>(shown_coarsening_));
-  }
+  if (!surface) return false;
+  const VoxelMesh& mesh = surface->mesh;
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToFloat();
   points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
@@ -340,13 +397,15 @@ void OctomapRenderer::extract() {
   poly->GetPointData()->SetScalars(height);
   auto* mapper = vtkPolyDataMapper::SafeDownCast(actor_->GetMapper());
   mapper->SetInputData(poly);
-  mapper->SetScalarRange(zmin, zmax);
+  mapper->SetScalarRange(surface->zmin, surface->zmax);
   shown_ = mesh.voxels;
   quads_ = mesh.quads.size();
+  shown_coarsening_ = surface->coarsening_shown;
   char text[128];
-  std::snprintf(text, sizeof(text), "map: %zu voxels of %.2f m%s", shown_, resolution,
+  std::snprintf(text, sizeof(text), "map: %zu voxels of %.2f m%s", shown_, surface->resolution,
                 shown_coarsening_ > coarsening_ ? " (coarser: quad budget)" : "");
   label_->SetInput(text);
+  return true;
 }
 
 void OctomapRenderer::on_enabled(bool on) {

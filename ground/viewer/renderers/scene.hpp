@@ -115,14 +115,10 @@ class OctomapRenderer : public Renderer {
 
  private:
   struct Map;
-  void extract();
 
   std::string channel_;
   std::unique_ptr<Map> map_;
-  uint64_t seen_ = 0;
   int coarsening_ = 0, shown_coarsening_ = 0;
-  size_t max_quads_;
-  bool dirty_ = false;
   size_t shown_ = 0, quads_ = 0;
   vtkSmartPointer<vtkActor> actor_;
   vtkSmartPointer<vtkTextActor> label_;

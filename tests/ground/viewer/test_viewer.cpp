@@ -231,10 +231,10 @@ TEST_F(Fixture, OctomapVoxelsAppearWhereTheMapHasThem) {
   const int spread = std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]});
   EXPECT_GT(spread, 60) << "expected a height-coloured voxel at " << p << ", got " << cv::Mat(c).t();
   // Coarser display resolution: fewer (merged) voxels.
-  oct->set_coarsening(2);
-  viewer->render_frame();
-  EXPECT_LT(oct->voxels_shown(), static_cast<size_t>(expected));
+  oct->set_coarsening(2);  // meshed in the renderer's own thread
+  ASSERT_TRUE(render_until([&] { return oct->voxels_shown() < static_cast<size_t>(expected); }));
   EXPECT_GT(oct->voxels_shown(), 0u);
+  EXPECT_EQ(oct->coarsening_shown(), 2);
 }
 
 // Panes are redrawn only when they change: a new camera image redraws the image pane
