@@ -213,7 +213,14 @@ Timing time_both(const std::vector<const std::vector<Eigen::Vector3f>*>& clouds,
   return best;
 }
 
-int run_throughput(const std::string& scan_path, const fs::path& out, int sim_frames, int repeats) {
+struct ThroughputRuns {
+  std::vector<double> resolutions{0.05, 0.1, 0.2}, ranges{5.0, 10.0};
+  std::vector<std::string> inputs{"scan", "sim"};
+  bool has(const std::string& input) const { return std::find(inputs.begin(), inputs.end(), input) != inputs.end(); }
+};
+
+int run_throughput(const std::string& scan_path, const fs::path& out, int sim_frames, int repeats,
+                   const ThroughputRuns& runs) {
   std::ofstream csv(out / "throughput.csv");
   csv << "input,resolution_m,max_range_m,points,octomap_mpts_s,ours_mpts_s,speedup,octomap_wall_mpts_s,"
          "ours_wall_mpts_s,speedup_wall\n";
@@ -228,11 +235,14 @@ int run_throughput(const std::string& scan_path, const fs::path& out, int sim_fr
     csv << input << "," << res << "," << range << "," << t.points << "," << a << "," << b << "," << b / a << "," << aw
         << "," << bw << "," << bw / aw << "\n";
   };
-  const auto scan = aerie::map::bench::read_bz2_xyz(scan_path);
-  std::cout << "example scan: " << scan.size() << " points (origin 0,0,0)\n";
-  for (double range : {5.0, 10.0})
-    for (double res : {0.05, 0.1, 0.2})
-      report("scan", res, range, time_both({&scan}, {Eigen::Vector3f::Zero()}, params_for(res, range, nullptr), repeats));
+  if (runs.has("scan")) {
+    const auto scan = aerie::map::bench::read_bz2_xyz(scan_path);
+    std::cout << "example scan: " << scan.size() << " points (origin 0,0,0)\n";
+    for (double range : runs.ranges)
+      for (double res : runs.resolutions)
+        report("scan", res, range, time_both({&scan}, {Eigen::Vector3f::Zero()}, params_for(res, range, nullptr), repeats));
+  }
+  if (!runs.has("sim")) return 0;
 
   const auto s = simulate(sim::RigConfig{}, 4, sim_frames, Noise::Sgbm, 1.0f,
                           out / ("frames_sgbm_s4_n" + std::to_string(sim_frames) + "_b1.bin"));
@@ -243,8 +253,8 @@ int run_throughput(const std::string& scan_path, const fs::path& out, int sim_fr
     origins.push_back(f.origin);
   }
   std::cout << "simulated flight: " << s.frames.size() << " frames of SGBM depth, 376x240, 1 deg bins\n";
-  for (double range : {5.0, 10.0})
-    for (double res : {0.05, 0.1, 0.2})
+  for (double range : runs.ranges)
+    for (double res : runs.resolutions)
       report("sim_sgbm", res, range, time_both(clouds, origins, params_for(res, range, &s), repeats));
   return 0;
 }
@@ -419,6 +429,12 @@ int main(int argc, char** argv) {
   tp->add_option("--scan", scan, "OctoMap example scan (.bz2, x y z per line)")->capture_default_str();
   tp->add_option("--sim-frames", sim_frames, "simulated SGBM frames")->capture_default_str();
   tp->add_option("--repeats", repeats, "best of N runs")->capture_default_str();
+  ThroughputRuns runs;
+  tp->add_option("--resolutions", runs.resolutions, "map resolutions (m)")->capture_default_str();
+  tp->add_option("--ranges", runs.ranges, "sensor_model/max_range values (m)")->capture_default_str();
+  tp->add_option("--inputs", runs.inputs, "scan (OctoMap example scan) and/or sim (simulated SGBM depth)")
+      ->check(CLI::IsMember({"scan", "sim"}))
+      ->capture_default_str();
   auto* ql = app.add_subcommand("quality", "wrongly occupied / free voxels vs the simulator's exact geometry");
   std::string noise = "sgbm";
   int stride = 4, max_frames = 1000;
@@ -444,7 +460,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     fs::create_directories(out_dir);
-    if (*tp) return run_throughput(scan, out_dir, sim_frames, repeats);
+    if (*tp) return run_throughput(scan, out_dir, sim_frames, repeats, runs);
     if (*ql)
       return run_quality(out_dir, noise == "sgbm" ? Noise::Sgbm : noise == "model" ? Noise::Model : Noise::Exact, stride,
                          max_frames, range, ov);
