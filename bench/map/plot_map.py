@@ -33,7 +33,7 @@ def throughput(src, dst):
         ax.text(x + 0.2, float(row["ours_mpts_s"]), f"x{float(row['speedup']):.1f}", ha="center", va="bottom", fontsize=8)
     ax.set_xticks(list(xs))
     ax.set_xticklabels(labels, fontsize=7)
-    ax.set_ylabel("M points / s (single thread)")
+    ax.set_ylabel("M points / s of thread CPU time")
     ax.set_title("Insertion throughput (resolution / max range)")
     ax.legend()
     fig.tight_layout()
