@@ -307,6 +307,10 @@ struct Overrides {
   float bin_deg = 1.0f;
   uint64_t seed = 1;
   bool skip_octomap = false;  // parameter studies of the robust update only
+  // A parameter study (robust update only or parameters changed): its CSV gets its own name.
+  bool study() const {
+    return skip_octomap || disparity_sigma >= 0 || free_margin >= 0 || visibility >= 0 || weight_hits >= 0;
+  }
   void apply(OccupancyParams& p) const {
     if (disparity_sigma >= 0) p.stereo.disparity_sigma_px = disparity_sigma;
     if (free_margin >= 0) p.stereo.free_margin_sigmas = free_margin;
@@ -323,7 +327,8 @@ int run_quality(const fs::path& out, Noise noise, int stride, int max_frames, do
   const auto s = simulate(sim::RigConfig{}, stride, max_frames, noise, ov.bin_deg, out / cache_name.str(), ov.seed);
   std::cout << "simulated demo flight in room seed " << ov.seed << ": " << s.frames.size() << " frames (every " << stride
             << "th at 20 Hz), 376x240, noise " << noise_name << ", max range " << range << " m\n";
-  std::ofstream csv(out / ("quality_" + std::string(noise_name) + "_w" + std::to_string(ov.seed) + ".csv"));
+  std::ofstream csv(out / ("quality_" + std::string(noise_name) + "_w" + std::to_string(ov.seed) +
+                           (ov.study() ? "_study" : "") + ".csv"));
   csv << "method,resolution_m,occupied_voxels,free_voxels,artifacts,artifacts_pct,wrongly_free,solid_known,"
          "wrongly_free_pct,surface_occupied_pct,memory_bytes,nodes,seconds\n";
   for (double res : ov.resolutions) {

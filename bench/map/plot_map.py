@@ -42,6 +42,8 @@ def throughput(src, dst):
 
 def quality(src, dst):
     for path in sorted(glob.glob(os.path.join(src, "quality_*.csv"))):
+        if path.endswith("_study.csv"):  # parameter studies: robust update only
+            continue
         r = rows(path)
         name = os.path.splitext(os.path.basename(path))[0]
         res = sorted({float(x["resolution_m"]) for x in r})
