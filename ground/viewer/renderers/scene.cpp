@@ -230,6 +230,7 @@ struct OctomapRenderer::Map {
 void OctomapRenderer::Map::run() {
   std::unique_ptr<octomap::OcTree> tree;
   uint64_t meshed_settings = 0;
+  int last_levels = 0;  // shown last time: a growing map does not get finer again
   for (;;) {
     std::deque<std::pair<std::unique_ptr<octomap::OcTree>, bool>> messages;
     int levels = 0;
@@ -239,7 +240,7 @@ void OctomapRenderer::Map::run() {
       wake.wait(lock, [&] { return stop || !inbox.empty() || settings != meshed_settings; });
       if (stop) return;
       messages.swap(inbox);
-      levels = coarsening;
+      levels = settings != meshed_settings ? coarsening : std::max(coarsening, last_levels);
       budget = max_quads;
       meshed_settings = settings;
     }
@@ -264,6 +265,7 @@ void OctomapRenderer::Map::run() {
     while (budget > 0 && s.mesh.quads.size() > budget && s.coarsening_shown < 4)
       s.mesh = mesh_occupied_surface(*tree, ++s.coarsening_shown);
     s.resolution = tree->getNodeSize(tree->getTreeDepth() - static_cast<unsigned>(s.coarsening_shown));
+    last_levels = s.coarsening_shown;
     std::lock_guard lock(m);
     ready = std::move(s);
   }
