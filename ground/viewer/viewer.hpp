@@ -36,7 +36,7 @@ struct ViewerOptions {
   double pane_fps = 10;
   bool always_redraw = false;
   // OctoMap display: more quads than this and the map is shown one level coarser (0: no limit).
-  size_t map_max_quads = 40000;
+  size_t map_max_quads = 60000;
   std::string image_channel = "CAM_LEFT";
   std::string track_cmd_channel = "TRACK_CMD";
   std::vector<std::string> trackers = {"amcmr-ct", "am3", "ipsl-mr", "ct", "mil", "ipsl"};

@@ -96,7 +96,7 @@ class DepthCloudRenderer : public Renderer {
 // so on) and the pane says so; 0 = no limit.
 class OctomapRenderer : public Renderer {
  public:
-  explicit OctomapRenderer(std::string channel = "MAP_OCTOMAP", size_t max_quads = 40000);
+  explicit OctomapRenderer(std::string channel = "MAP_OCTOMAP", size_t max_quads = 60000);
   ~OctomapRenderer() override;
   void subscribe(bus::Bus& bus) override;
   void attach(Layout& layout) override;
