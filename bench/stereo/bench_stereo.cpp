@@ -251,6 +251,15 @@ int main(int argc, char** argv) {
     const double measured = 1.0 - ms["SGBM_F"] / ms["SGM_full"];
     const double ours_model = 1.0 - (1.0 / 8 + double(cp.fine_window) / D);
     const auto& t = ctf.timings();
+    auto stages = [](const aerie::stereo::SgmTimings& s) {
+      std::ostringstream o;
+      o << std::setprecision(3) << "census " << s.census_ms << ", cost " << s.cost_ms << ", aggregate "
+        << s.aggregate_ms << ", select " << s.select_ms;
+      return o.str();
+    };
+    full.compute(p.left, p.right);
+    std::cout << "SGM stages ms: SGBM_F coarse [" << stages(ctf.coarse_sgm_timings()) << "], fine ["
+              << stages(ctf.fine_sgm_timings()) << "]; SGM_full [" << stages(full.timings()) << "]\n";
     std::cout << std::setprecision(3) << "SGBM_F stages ms: pyramid " << t.pyramid_ms << ", coarse " << t.coarse_ms
               << ", prior " << t.prior_ms << ", fine " << t.fine_ms << "\n"
               << "saving vs full SGM: measured " << measured << ", eq. 4.3 (eta " << eta << ") " << predicted

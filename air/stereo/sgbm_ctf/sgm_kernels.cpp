@@ -26,8 +26,10 @@ void Census(const CensusArgs& a) {
   const int nplanes = (a.nbits + 7) / 8;
   for (int y = 0; y < a.height; ++y) {
     const uint8_t* row = a.image + y * a.image_step;
-    int x = 0;
-    for (; x + n <= a.width; x += n) {
+    // Whole vectors; the last one overlaps its predecessor rather than leaving a scalar tail.
+    const int vector_end = a.width >= n ? a.width : 0;
+    for (int x0 = 0; x0 < vector_end; x0 += n) {
+      const int x = std::min(x0, a.width - n);
       const auto centre = hn::LoadU(d, row + x);
       for (int p = 0; p < nplanes; ++p) {
         auto acc = hn::Zero(d);
@@ -39,7 +41,7 @@ void Census(const CensusArgs& a) {
         hn::StoreU(acc, d, a.out + (y * nplanes + p) * a.out_step + x);
       }
     }
-    for (; x < a.width; ++x) {  // tail narrower than a vector
+    for (int x = vector_end; x < a.width; ++x) {  // images narrower than a vector
       for (int p = 0; p < nplanes; ++p) {
         uint8_t acc = 0;
         for (int b = 0; b < 8 && 8 * p + b < a.nbits; ++b) {
