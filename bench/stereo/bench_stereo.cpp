@@ -115,16 +115,18 @@ cv::Mat from_opencv(const cv::Mat& d16) {  // CV_16S x16 -> CV_32F, invalid -1
   return d;
 }
 
-// Thread CPU time (cpu_time.hpp), the fastest of `repeats` runs: on a machine shared with
-// other jobs this is the figure least disturbed by them.
-double best_ms(int repeats, const std::function<void()>& f) {
-  f();  // warm-up (allocation, caches)
-  double best = 1e30;
-  for (int i = 0; i < repeats; ++i) {
-    aerie::stereo::CpuStopwatch sw;
-    f();
-    best = std::min(best, sw.ms());
-  }
+// Thread CPU time (cpu_time.hpp) of each method, the fastest of `repeats` rounds. The
+// methods run in turn within every round, so that a change of the machine's load (it is
+// shared with other jobs) affects them all alike; the minimum is the figure least disturbed.
+template <class Method>
+std::vector<double> best_ms(int repeats, const std::vector<Method>& methods) {
+  std::vector<double> best(methods.size(), 1e30);
+  for (int round = 0; round < repeats; ++round)
+    for (size_t i = 0; i < methods.size(); ++i) {
+      aerie::stereo::CpuStopwatch sw;
+      methods[i].run();
+      best[i] = std::min(best[i], sw.ms());
+    }
   return best;
 }
 
@@ -141,12 +143,12 @@ void write_colour(const cv::Mat& disp, int D, const fs::path& path) {
 int main(int argc, char** argv) {
   CLI::App app{"Stereo matching benchmark: SGBM_F vs full-range SGM vs OpenCV BM/SGBM, single thread"};
   std::string pairs_dir = "../shared/data/stereo_pairs", out_dir = "bench-stereo-out";
-  int repeats = 5, block = 5, fine_window = 16;
+  int repeats = 9, block = 5, fine_window = 16;
   aerie::stereo::SgmParams sgm;
   app.add_option("--pairs", pairs_dir, "folder of stereo pairs with GT disparity (one subfolder each)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--out", out_dir, "folder for results.csv, results.json and disparity PNGs");
-  app.add_option("--repeats", repeats, "timed runs per method (the fastest is reported)")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "timed rounds over all methods (the fastest run of each is reported)")->check(CLI::PositiveNumber);
   app.add_option("--block", block, "OpenCV block size (P1 = 8 b^2, P2 = 32 b^2 as OpenCV recommends)");
   app.add_option("--fine-window", fine_window, "SGBM_F disparities searched per pixel at full resolution");
   app.add_option("--p1", sgm.p1, "our P1 (census costs)");
@@ -228,9 +230,12 @@ int main(int argc, char** argv) {
     json << (first_pair ? "" : ", ") << "{\"name\": \"" << p.name << "\", \"width\": " << p.left.cols
          << ", \"height\": " << p.left.rows << ", \"num_disparities\": " << D << ", \"methods\": {";
     first_pair = false;
+    std::vector<cv::Mat> disps;
+    for (const auto& m : methods) disps.push_back(m.run());  // also the warm-up (allocation, caches)
+    const std::vector<double> best = best_ms(repeats, methods);
     for (size_t i = 0; i < methods.size(); ++i) {
-      cv::Mat disp;
-      ms[methods[i].name] = best_ms(repeats, [&] { disp = methods[i].run(); });
+      const cv::Mat& disp = disps[i];
+      ms[methods[i].name] = best[i];
       const Score s = score(disp, p.gt);
       std::cout << std::left << std::setw(16) << methods[i].name << std::right << std::fixed << std::setprecision(1)
                 << std::setw(9) << ms[methods[i].name] << std::setw(8) << s.bad[0] << std::setw(8) << s.bad[1]

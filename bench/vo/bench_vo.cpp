@@ -3,6 +3,7 @@
 // (ATE after SE3 alignment, RPE per frame and over segments, per-axis RMSE, end-point
 // drift), with the thread CPU time of every stage.
 #include <CLI/CLI.hpp>
+#include <opencv2/core/utility.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -123,6 +124,9 @@ int main(int argc, char** argv) {
   app.add_flag("--exact-depth", exact_depth, "sim only: use the renderer's exact disparity instead of SGBM_F "
                                           "(separates depth errors from tracking errors)");
   CLI11_PARSE(app, argc, argv);
+  // Single thread: the stage timings are thread CPU time, which would miss work that OpenCV
+  // hands to its pool. The bundle adjuster keeps its own thread.
+  cv::setNumThreads(1);
   try {
     stereo::VoParams params =
         config.empty() ? stereo::VoParams{} : stereo::vo_params_from_config(util::Config::load(config), {"node"});
