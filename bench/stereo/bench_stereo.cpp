@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
   std::ostringstream json;
   json << "{\"simd\": \"" << aerie::stereo::SemiGlobalMatcher::simd_target() << "\", \"pairs\": [";
   std::cout << "SIMD target: " << aerie::stereo::SemiGlobalMatcher::simd_target() << ", single thread, CPU ms, best of "
-            << repeats << " runs\n";
+            << repeats << " interleaved rounds\n";
   bool first_pair = true;
   for (const auto& dir : dirs) {
     Pair p;

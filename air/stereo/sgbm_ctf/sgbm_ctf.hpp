@@ -49,7 +49,7 @@ class CoarseToFineSgbm {
   SgbmCtfParams params_;
   SemiGlobalMatcher coarse_matcher_, fine_matcher_;
   SgbmCtfTimings timings_;
-  cv::Mat left_half_, right_half_, coarse_, offsets_;
+  cv::Mat left_half_, right_half_, coarse_, coarse_start_, offsets_;
   double coarse_density_ = 0;
 };
 
