@@ -101,7 +101,7 @@ cv::Mat CoarseToFineSgbm::compute(const cv::Mat& left, const cv::Mat& right) {
     for (int cx = 0; cx < filled.cols; ++cx) {
       const float span = 2.f * (h[cx] - l[cx]);
       const float centre = span <= W - 4 ? (h[cx] + l[cx]) : 2.f * c[cx];
-      const int start = static_cast<int>(std::lround(centre)) - W / 2;
+      const int start = static_cast<int>(centre + 0.5f) - W / 2;  // rounded (centre >= 0)
       o[cx] = static_cast<int16_t>(std::clamp(start, 0, D - W));
     }
   }
