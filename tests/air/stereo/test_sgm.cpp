@@ -80,6 +80,25 @@ TEST(Sgm, SlantedPlaneWithinHalfPixel) {
   }
 }
 
+// Sizes that are not multiples of any vector width (the census' last vector overlaps, the
+// half-resolution pair of SGBM_F has odd sizes).
+TEST(Sgm, OddSizesWithinHalfPixel) {
+  const Plane plane{12.0, 0.03, 0.02};
+  cv::Mat left, right;
+  make_pair(plane, {333, 181}, left, right);
+  SgmParams p;
+  p.num_disparities = 48;
+  SemiGlobalMatcher full(p);
+  const Error ef = compare(full.compute(left, right), plane, 4);
+  EXPECT_LT(ef.rms, 0.5);
+  EXPECT_GT(ef.density, 0.95);
+  CoarseToFineSgbm ctf({p, 16});
+  const Error ec = compare(ctf.compute(left, right), plane, 4);
+  EXPECT_LT(ec.rms, 0.5);
+  EXPECT_GT(ec.density, 0.95);
+  EXPECT_EQ(ctf.coarse_disparity().cols, 166);  // cvRound(333 * 0.5), half to even
+}
+
 TEST(Sgm, RestrictedWindowFindsOnlyDisparitiesInside) {
   const Plane plane{20.0, 0.0, 0.0};
   cv::Mat left, right;
