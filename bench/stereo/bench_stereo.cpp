@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -276,6 +277,12 @@ int main(int argc, char** argv) {
   }
   json << "]}\n";
   std::ofstream(fs::path(out_dir) / "results.json") << json.str();
-  std::cout << "\nwrote " << (fs::path(out_dir) / "results.csv").string() << ", results.json and PNGs\n";
+  // Bar charts of time and bad-2px (matplotlib).
+  const fs::path script = fs::path(AERIE_BENCH_STEREO_DIR) / "plot_stereo.py";
+  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + (fs::path(out_dir) / "results.csv").string() +
+                          "' '" + (fs::path(out_dir) / "stereo.png").string() + "'";
+  if (std::system(cmd.c_str()) != 0) std::cerr << "plot failed: " << cmd << "\n";
+  std::cout << "\nwrote " << (fs::path(out_dir) / "results.csv").string() << ", results.json, stereo.png and the "
+            << "disparity PNGs\n";
   return 0;
 }
