@@ -277,6 +277,7 @@ int main(int argc, char** argv) {
   }
   json << "]}\n";
   std::ofstream(fs::path(out_dir) / "results.json") << json.str();
+  csv.close();
   // Bar charts of time and bad-2px (matplotlib).
   const fs::path script = fs::path(AERIE_BENCH_STEREO_DIR) / "plot_stereo.py";
   const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + (fs::path(out_dir) / "results.csv").string() +
