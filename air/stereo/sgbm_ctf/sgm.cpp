@@ -133,7 +133,8 @@ cv::Mat SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, co
     const int16_t* orow = offsets.ptr<int16_t>(y);
     kernels::SelectRowArgs sa{sum_.data() + static_cast<size_t>(y) * width * window, orow, width, window,
                               params_.uniqueness_percent, drow, params_.subpixel, right_cost_.data() + rpad,
-                              right_disp_.data() + rpad};
+                              right_disp_.data() + rpad,
+                              static_cast<uint16_t>(params_.paths * (nbits + params_.p2))};
     kernels::select_row(sa);
     if (params_.lr_max_diff >= 0) {
       const int16_t* rdisp = right_disp_.data() + rpad;
