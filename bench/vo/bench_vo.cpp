@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
         const auto aligned = eval::align(a.est, a.ref, eval::Alignment::SE3);
         const fs::path csv = fs::path(plot).replace_extension(".csv");
         std::ofstream c(csv);
-        c << "t,gx,gy,gz,ex,ey,ez\n" << std::setprecision(9);
+        c << "t,gx,gy,gz,ex,ey,ez\n" << std::fixed << std::setprecision(6);  // absolute stamps (EuRoC: 1.4e9 s)
         for (size_t i = 0; i < a.ref.size(); ++i) {
           const auto& g = a.ref.poses[i].translation();
           const auto& e = aligned.poses[i].translation();
