@@ -141,7 +141,7 @@ void write_colour(const cv::Mat& disp, int D, const fs::path& path) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{"Stereo matching benchmark: SGBM_F vs full-range SGM vs OpenCV BM/SGBM, single thread"};
   std::string pairs_dir = "../shared/data/stereo_pairs", out_dir = "bench-stereo-out";
   int repeats = 9, block = 5, fine_window = 16;
@@ -286,4 +286,7 @@ int main(int argc, char** argv) {
   std::cout << "\nwrote " << (fs::path(out_dir) / "results.csv").string() << ", results.json, stereo.png and the "
             << "disparity PNGs\n";
   return 0;
+} catch (const std::exception& e) {  // bad parameters, unreadable files
+  std::cerr << "aerie-bench-stereo: " << e.what() << '\n';
+  return 1;
 }
