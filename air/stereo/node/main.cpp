@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("vo", common.log_level);
   // The front end is one thread by design (the bundle adjuster has its own): OpenCV's pool
-  // would only add hand-off overhead (KITTI: 13.4 -> 10.1 ms per frame without it) and
+  // would only add hand-off overhead (KITTI: 13.4 ms per frame with it, 10.1 ms without) and
   // hide work from the per-stage thread CPU times in STATUS_VO.
   cv::setNumThreads(1);
   try {
