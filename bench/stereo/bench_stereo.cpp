@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -115,16 +116,18 @@ cv::Mat from_opencv(const cv::Mat& d16) {  // CV_16S x16 -> CV_32F, invalid -1
   return d;
 }
 
-// Thread CPU time (cpu_time.hpp), the fastest of `repeats` runs: on a machine shared with
-// other jobs this is the figure least disturbed by them.
-double best_ms(int repeats, const std::function<void()>& f) {
-  f();  // warm-up (allocation, caches)
-  double best = 1e30;
-  for (int i = 0; i < repeats; ++i) {
-    aerie::stereo::CpuStopwatch sw;
-    f();
-    best = std::min(best, sw.ms());
-  }
+// Thread CPU time (cpu_time.hpp) of each method, the fastest of `repeats` rounds. The
+// methods run in turn within every round, so that a change of the machine's load (it is
+// shared with other jobs) affects them all alike; the minimum is the figure least disturbed.
+template <class Method>
+std::vector<double> best_ms(int repeats, const std::vector<Method>& methods) {
+  std::vector<double> best(methods.size(), 1e30);
+  for (int round = 0; round < repeats; ++round)
+    for (size_t i = 0; i < methods.size(); ++i) {
+      aerie::stereo::CpuStopwatch sw;
+      methods[i].run();
+      best[i] = std::min(best[i], sw.ms());
+    }
   return best;
 }
 
@@ -138,15 +141,15 @@ void write_colour(const cv::Mat& disp, int D, const fs::path& path) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{"Stereo matching benchmark: SGBM_F vs full-range SGM vs OpenCV BM/SGBM, single thread"};
   std::string pairs_dir = "../shared/data/stereo_pairs", out_dir = "bench-stereo-out";
-  int repeats = 5, block = 5, fine_window = 16;
+  int repeats = 9, block = 5, fine_window = 16;
   aerie::stereo::SgmParams sgm;
   app.add_option("--pairs", pairs_dir, "folder of stereo pairs with GT disparity (one subfolder each)")
       ->check(CLI::ExistingDirectory);
   app.add_option("--out", out_dir, "folder for results.csv, results.json and disparity PNGs");
-  app.add_option("--repeats", repeats, "timed runs per method (the fastest is reported)")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "timed rounds over all methods (the fastest run of each is reported)")->check(CLI::PositiveNumber);
   app.add_option("--block", block, "OpenCV block size (P1 = 8 b^2, P2 = 32 b^2 as OpenCV recommends)");
   app.add_option("--fine-window", fine_window, "SGBM_F disparities searched per pixel at full resolution");
   app.add_option("--p1", sgm.p1, "our P1 (census costs)");
@@ -169,7 +172,7 @@ int main(int argc, char** argv) {
   std::ostringstream json;
   json << "{\"simd\": \"" << aerie::stereo::SemiGlobalMatcher::simd_target() << "\", \"pairs\": [";
   std::cout << "SIMD target: " << aerie::stereo::SemiGlobalMatcher::simd_target() << ", single thread, CPU ms, best of "
-            << repeats << " runs\n";
+            << repeats << " interleaved rounds\n";
   bool first_pair = true;
   for (const auto& dir : dirs) {
     Pair p;
@@ -228,9 +231,12 @@ int main(int argc, char** argv) {
     json << (first_pair ? "" : ", ") << "{\"name\": \"" << p.name << "\", \"width\": " << p.left.cols
          << ", \"height\": " << p.left.rows << ", \"num_disparities\": " << D << ", \"methods\": {";
     first_pair = false;
+    std::vector<cv::Mat> disps;
+    for (const auto& m : methods) disps.push_back(m.run());  // also the warm-up (allocation, caches)
+    const std::vector<double> best = best_ms(repeats, methods);
     for (size_t i = 0; i < methods.size(); ++i) {
-      cv::Mat disp;
-      ms[methods[i].name] = best_ms(repeats, [&] { disp = methods[i].run(); });
+      const cv::Mat& disp = disps[i];
+      ms[methods[i].name] = best[i];
       const Score s = score(disp, p.gt);
       std::cout << std::left << std::setw(16) << methods[i].name << std::right << std::fixed << std::setprecision(1)
                 << std::setw(9) << ms[methods[i].name] << std::setw(8) << s.bad[0] << std::setw(8) << s.bad[1]
@@ -251,6 +257,15 @@ int main(int argc, char** argv) {
     const double measured = 1.0 - ms["SGBM_F"] / ms["SGM_full"];
     const double ours_model = 1.0 - (1.0 / 8 + double(cp.fine_window) / D);
     const auto& t = ctf.timings();
+    auto stages = [](const aerie::stereo::SgmTimings& s) {
+      std::ostringstream o;
+      o << std::setprecision(3) << "census " << s.census_ms << ", cost " << s.cost_ms << ", aggregate "
+        << s.aggregate_ms << ", select " << s.select_ms;
+      return o.str();
+    };
+    full.compute(p.left, p.right);
+    std::cout << "SGM stages ms: SGBM_F coarse [" << stages(ctf.coarse_sgm_timings()) << "], fine ["
+              << stages(ctf.fine_sgm_timings()) << "]; SGM_full [" << stages(full.timings()) << "]\n";
     std::cout << std::setprecision(3) << "SGBM_F stages ms: pyramid " << t.pyramid_ms << ", coarse " << t.coarse_ms
               << ", prior " << t.prior_ms << ", fine " << t.fine_ms << "\n"
               << "saving vs full SGM: measured " << measured << ", eq. 4.3 (eta " << eta << ") " << predicted
@@ -262,6 +277,16 @@ int main(int argc, char** argv) {
   }
   json << "]}\n";
   std::ofstream(fs::path(out_dir) / "results.json") << json.str();
-  std::cout << "\nwrote " << (fs::path(out_dir) / "results.csv").string() << ", results.json and PNGs\n";
+  csv.close();
+  // Bar charts of time and bad-2px (matplotlib).
+  const fs::path script = fs::path(AERIE_BENCH_STEREO_DIR) / "plot_stereo.py";
+  const std::string cmd = "/usr/bin/python3 '" + script.string() + "' '" + (fs::path(out_dir) / "results.csv").string() +
+                          "' '" + (fs::path(out_dir) / "stereo.png").string() + "'";
+  if (std::system(cmd.c_str()) != 0) std::cerr << "plot failed: " << cmd << "\n";
+  std::cout << "\nwrote " << (fs::path(out_dir) / "results.csv").string() << ", results.json, stereo.png and the "
+            << "disparity PNGs\n";
   return 0;
+} catch (const std::exception& e) {  // bad parameters, unreadable files
+  std::cerr << "aerie-bench-stereo: " << e.what() << '\n';
+  return 1;
 }

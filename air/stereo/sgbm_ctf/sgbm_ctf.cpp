@@ -71,10 +71,10 @@ cv::Mat CoarseToFineSgbm::compute(const cv::Mat& left, const cv::Mat& right) {
     coarse_density_ = 0;
     return disparity;
   }
-  // Half resolution by area averaging (a 2x2 box, no aliasing of the census patterns).
-  const cv::Size half((left.cols + 1) / 2, (left.rows + 1) / 2);
-  cv::resize(left, left_half_, half, 0, 0, cv::INTER_AREA);
-  cv::resize(right, right_half_, half, 0, 0, cv::INTER_AREA);
+  // Half resolution by area averaging (a 2x2 box, no aliasing of the census patterns). The
+  // scale factors, not a target size, select OpenCV's exact 2x2 path for odd sizes too.
+  cv::resize(left, left_half_, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  cv::resize(right, right_half_, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
   timings_.pyramid_ms = sw.ms();
 
   sw.reset();
@@ -91,20 +91,25 @@ cv::Mat CoarseToFineSgbm::compute(const cv::Mat& left, const cv::Mat& right) {
   cv::Mat lo, hi;
   cv::erode(filled, lo, cv::Mat());
   cv::dilate(filled, hi, cv::Mat());
-  offsets_.create(left.size(), CV_16SC1);
-  for (int y = 0; y < left.rows; ++y) {
-    const int cy = std::min(y / 2, filled.rows - 1);
+  // The window start of each coarse pixel, then replicated over its 2x2 full-resolution block.
+  coarse_start_.create(filled.size(), CV_16SC1);
+  for (int cy = 0; cy < filled.rows; ++cy) {
     const float* c = filled.ptr<float>(cy);
     const float* l = lo.ptr<float>(cy);
     const float* h = hi.ptr<float>(cy);
-    int16_t* o = offsets_.ptr<int16_t>(y);
-    for (int x = 0; x < left.cols; ++x) {
-      const int cx = std::min(x / 2, filled.cols - 1);
+    int16_t* o = coarse_start_.ptr<int16_t>(cy);
+    for (int cx = 0; cx < filled.cols; ++cx) {
       const float span = 2.f * (h[cx] - l[cx]);
       const float centre = span <= W - 4 ? (h[cx] + l[cx]) : 2.f * c[cx];
-      const int start = static_cast<int>(std::lround(centre)) - W / 2;
-      o[x] = static_cast<int16_t>(std::clamp(start, 0, D - W));
+      const int start = static_cast<int>(centre + 0.5f) - W / 2;  // rounded (centre >= 0)
+      o[cx] = static_cast<int16_t>(std::clamp(start, 0, D - W));
     }
+  }
+  offsets_.create(left.size(), CV_16SC1);
+  for (int y = 0; y < left.rows; ++y) {
+    const int16_t* c = coarse_start_.ptr<int16_t>(std::min(y / 2, filled.rows - 1));
+    int16_t* o = offsets_.ptr<int16_t>(y);
+    for (int x = 0; x < left.cols; ++x) o[x] = c[std::min(x / 2, filled.cols - 1)];
   }
   timings_.prior_ms = sw.ms();
 

@@ -33,6 +33,9 @@ class CoarseToFineSgbm {
 
   const SgbmCtfParams& params() const { return params_; }
   const SgbmCtfTimings& timings() const { return timings_; }
+  // Stage timings of the two SGM passes of the last call (census, costs, aggregation, selection).
+  const SgmTimings& coarse_sgm_timings() const { return coarse_matcher_.timings(); }
+  const SgmTimings& fine_sgm_timings() const { return fine_matcher_.timings(); }
   const cv::Mat& coarse_disparity() const { return coarse_; }  // half resolution, half range
   // Density eta of the coarse prior (valid fraction) of the last call (eq. 4.4).
   double coarse_density() const { return coarse_density_; }
@@ -46,7 +49,7 @@ class CoarseToFineSgbm {
   SgbmCtfParams params_;
   SemiGlobalMatcher coarse_matcher_, fine_matcher_;
   SgbmCtfTimings timings_;
-  cv::Mat left_half_, right_half_, coarse_, offsets_;
+  cv::Mat left_half_, right_half_, coarse_, coarse_start_, offsets_;
   double coarse_density_ = 0;
 };
 

@@ -80,8 +80,9 @@ cv::Mat SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, co
   //    for the pixels left of the right image.
   CpuStopwatch sw;
   const ptrdiff_t cstep = width + D + 2 * kernels::kWindowStep;
-  census_left_.assign(static_cast<size_t>(cstep) * height * nplanes, 0);
-  census_right_.assign(census_left_.size(), 0);
+  // (No clearing between calls: the margins are only read for costs the kernel masks.)
+  census_left_.resize(static_cast<size_t>(cstep) * height * nplanes);
+  census_right_.resize(census_left_.size());
   for (int side = 0; side < 2; ++side) {
     if (side) {
       cv::flip(right, flipped_, 1);
@@ -132,13 +133,14 @@ cv::Mat SemiGlobalMatcher::compute(const cv::Mat& left, const cv::Mat& right, co
     const int16_t* orow = offsets.ptr<int16_t>(y);
     kernels::SelectRowArgs sa{sum_.data() + static_cast<size_t>(y) * width * window, orow, width, window,
                               params_.uniqueness_percent, drow, params_.subpixel, right_cost_.data() + rpad,
-                              right_disp_.data() + rpad};
+                              right_disp_.data() + rpad,
+                              static_cast<uint16_t>(params_.paths * (nbits + params_.p2))};
     kernels::select_row(sa);
     if (params_.lr_max_diff >= 0) {
       const int16_t* rdisp = right_disp_.data() + rpad;
       for (int x = 0; x < width; ++x) {
         if (drow[x] < 0) continue;
-        const int d = static_cast<int>(std::lround(drow[x]));
+        const int d = static_cast<int>(drow[x] + 0.5f);  // rounded (disparities are >= 0)
         const int xr = x - d;
         if (xr < 0 || rdisp[xr] < 0 || std::abs(rdisp[xr] - d) > params_.lr_max_diff) drow[x] = kInvalidDisparity;
       }

@@ -26,8 +26,10 @@ void Census(const CensusArgs& a) {
   const int nplanes = (a.nbits + 7) / 8;
   for (int y = 0; y < a.height; ++y) {
     const uint8_t* row = a.image + y * a.image_step;
-    int x = 0;
-    for (; x + n <= a.width; x += n) {
+    // Whole vectors; the last one overlaps its predecessor rather than leaving a scalar tail.
+    const int vector_end = a.width >= n ? a.width : 0;
+    for (int x0 = 0; x0 < vector_end; x0 += n) {
+      const int x = std::min(x0, a.width - n);
       const auto centre = hn::LoadU(d, row + x);
       for (int p = 0; p < nplanes; ++p) {
         auto acc = hn::Zero(d);
@@ -39,7 +41,7 @@ void Census(const CensusArgs& a) {
         hn::StoreU(acc, d, a.out + (y * nplanes + p) * a.out_step + x);
       }
     }
-    for (; x < a.width; ++x) {  // tail narrower than a vector
+    for (int x = vector_end; x < a.width; ++x) {  // images narrower than a vector
       for (int p = 0; p < nplanes; ++p) {
         uint8_t acc = 0;
         for (int b = 0; b < 8 && 8 * p + b < a.nbits; ++b) {
@@ -230,18 +232,29 @@ void SelectRow(const SelectRowArgs& a) {
   const int W = a.window;
   const auto vmax = hn::Set(d, uint16_t{0xFFFF});
   const auto two = hn::Set(di, int16_t{2});
+  // One chunk whose costs fit in 12 bits (the usual fine level): cost << 4 | lane packs the
+  // winner's cost and index into one value, found by a single minimum.
+  const bool packed = W == n && n == 16 && a.max_sum < 4096;
+  const auto lane = hn::Iota(d, 0);
   for (int x = 0; x < a.width; ++x) {
     const int o = a.offsets[x];
     const uint16_t* s = a.sum + static_cast<ptrdiff_t>(x) * W;
-    auto vmin = vmax;
-    for (int k0 = 0; k0 < W; k0 += n) vmin = hn::Min(vmin, hn::LoadU(d, s + k0));
-    const uint16_t best_cost = MinLane(d, vmin);
+    uint16_t best_cost;
     int best = 0;
-    for (int k0 = 0; k0 < W; k0 += n) {
-      const intptr_t i = hn::FindFirstTrue(d, hn::Eq(hn::LoadU(d, s + k0), hn::Set(d, best_cost)));
-      if (i >= 0) {
-        best = k0 + static_cast<int>(i);
-        break;
+    if (packed) {
+      const uint16_t m = MinLane(d, hn::Or(hn::ShiftLeft<4>(hn::LoadU(d, s)), lane));
+      best_cost = static_cast<uint16_t>(m >> 4);
+      best = m & 15;
+    } else {
+      auto vmin = vmax;
+      for (int k0 = 0; k0 < W; k0 += n) vmin = hn::Min(vmin, hn::LoadU(d, s + k0));
+      best_cost = MinLane(d, vmin);
+      for (int k0 = 0; k0 < W; k0 += n) {
+        const intptr_t i = hn::FindFirstTrue(d, hn::Eq(hn::LoadU(d, s + k0), hn::Set(d, best_cost)));
+        if (i >= 0) {
+          best = k0 + static_cast<int>(i);
+          break;
+        }
       }
     }
     // Right-image winners: right pixel x - (o + k) takes the lowest cost over all left pixels.

@@ -63,6 +63,7 @@ struct SelectRowArgs {
   // valid from index -(max disparity + window) (caller pads) and initialised to 0xFFFF / -1.
   uint16_t* right_cost;
   int16_t* right_disparity;
+  uint16_t max_sum;        // bound of an aggregated cost (paths * (census bits + P2))
 };
 void select_row(const SelectRowArgs& a);
 
