@@ -86,13 +86,7 @@ Deputy::Deputy(DeputyOptions options, OutputSink output) : options_(std::move(op
   install_sigchld_pipe();
   // Orphaned descendants of our commands are re-parented to us, not to init.
   prctl(PR_SET_CHILD_SUBREAPER, 1);
-  const HostSample h = read_host();
-  last_total_jiffies_ = h.total_jiffies;
-  last_busy_jiffies_ = h.busy_jiffies;
-  mem_total_ = h.mem_total_bytes;
-  mem_available_ = h.mem_available_bytes;
-  swap_total_ = h.swap_total_bytes;
-  swap_free_ = h.swap_free_bytes;
+  host_ = read_host();
 }
 
 Deputy::~Deputy() {
@@ -391,15 +385,10 @@ std::vector<int> Deputy::wait_fds() const {
 
 void Deputy::sample_usage() {
   const HostSample h = read_host();
-  const uint64_t dtotal = h.total_jiffies - last_total_jiffies_;
-  const uint64_t dbusy = h.busy_jiffies - last_busy_jiffies_;
+  const uint64_t dtotal = h.total_jiffies - host_.total_jiffies;
+  const uint64_t dbusy = h.busy_jiffies - host_.busy_jiffies;
   if (dtotal > 0 && dbusy <= dtotal) cpu_load_ = static_cast<float>(static_cast<double>(dbusy) / static_cast<double>(dtotal));
-  last_total_jiffies_ = h.total_jiffies;
-  last_busy_jiffies_ = h.busy_jiffies;
-  mem_total_ = h.mem_total_bytes;
-  mem_available_ = h.mem_available_bytes;
-  swap_total_ = h.swap_total_bytes;
-  swap_free_ = h.swap_free_bytes;
+  host_ = h;
 
   const auto all = read_all_processes();
   const pid_t self = getpid();
@@ -433,10 +422,10 @@ bot_procman::info2_t Deputy::report(int64_t utime) const {
   m.utime = utime;
   m.host = options_.name;
   m.cpu_load = cpu_load_;
-  m.phys_mem_total_bytes = mem_total_;
-  m.phys_mem_free_bytes = mem_available_;
-  m.swap_total_bytes = swap_total_;
-  m.swap_free_bytes = swap_free_;
+  m.phys_mem_total_bytes = host_.mem_total_bytes;
+  m.phys_mem_free_bytes = host_.mem_available_bytes;
+  m.swap_total_bytes = host_.swap_total_bytes;
+  m.swap_free_bytes = host_.swap_free_bytes;
   for (const auto& [id, c] : commands_) {
     bot_procman::deputy_cmd2_t d;
     d.cmd = c.cmd;

@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "procman/proc_stats.hpp"
+
 namespace aerie::procman {
 
 struct DeputyOptions {
@@ -118,9 +120,8 @@ class Deputy {
   std::map<int32_t, Command> commands_;
   bool exiting_ = false;
   int64_t last_stale_warning_ms_ = -1000000;
-  uint64_t last_total_jiffies_ = 0, last_busy_jiffies_ = 0;
+  HostSample host_;  // the last sample: memory, and the jiffies the CPU load is measured from
   float cpu_load_ = 0;
-  int64_t mem_total_ = 0, mem_available_ = 0, swap_total_ = 0, swap_free_ = 0;
 };
 
 const char* to_string(ProcState s);

@@ -35,14 +35,16 @@ struct Fixture : ::testing::Test {
   bus::Bus& bus = *bus_ptr;
   std::unique_ptr<Viewer> viewer;
 
-  void make(int w = 1280, int h = 800) {
+  void make(int w = 1280, int h = 800) { viewer = make_viewer(bus, w, h); }
+  static std::unique_ptr<Viewer> make_viewer(bus::Bus& b, int w, int h) {
     ViewerOptions o;
     o.width = w;
     o.height = h;
     o.offscreen = true;
-    viewer = std::make_unique<Viewer>(bus, o);
-    viewer->add_default_renderers();
-    viewer->start();
+    auto v = std::make_unique<Viewer>(b, o);
+    v->add_default_renderers();
+    v->start();
+    return v;
   }
   void TearDown() override {
     if (viewer) viewer->stop();
@@ -161,13 +163,7 @@ TEST_F(Fixture, BoxSelectionMapsBackToImageCoordinatesAtAnySizeAndZoom) {
       std::unique_ptr<Viewer>& v;
       ~ResetAtScopeEnd() { v.reset(); }
     } reset_viewer{viewer};
-    ViewerOptions o;
-    o.width = w;
-    o.height = h;
-    o.offscreen = true;
-    viewer = std::make_unique<Viewer>(bus, o);
-    viewer->add_default_renderers();
-    viewer->start();
+    viewer = make_viewer(bus, w, h);
     std::vector<aerie::track_cmd_t> cmds;
     bus.subscribe<aerie::track_cmd_t>("TRACK_CMD", [&](const aerie::track_cmd_t& c, const bus::ReceiveInfo&) {
       cmds.push_back(c);
