@@ -69,11 +69,13 @@ DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
   in.read("max_scale_change", p.max_scale_change);
   in.read("min_scale", p.min_scale);
   in.read("max_scale", p.max_scale);
+  in.read("flow_prediction", p.flow_prediction);
   in.read("redetection", p.redetection);
   in.read("confidence_rate", p.confidence_rate);
   in.read("lost_frames", p.lost_frames);
   in.read("found_confidence", p.found_confidence);
   in.read("redetect_stride", p.redetect_stride);
+  in.read("redetect_radius", p.redetect_radius);
   in.read("update_confidence", p.update_confidence);
   return p;
 }

@@ -67,6 +67,7 @@ DiscriminativeTracker::DiscriminativeTracker(std::string name, DiscriminativePar
   require(p.scale_step > 1 && p.max_scale_change > 1, "scale_step and max_scale_change must be > 1");
   require(p.min_scale > 0 && p.max_scale > p.min_scale, "need 0 < min_scale < max_scale");
   require(p.lost_frames >= 1 && p.redetect_stride >= 1, "lost_frames and redetect_stride must be >= 1");
+  require(p.redetect_radius >= 0, "redetect_radius must be >= 0");
   require(p.update_confidence >= 0 && p.update_confidence <= 1 && p.found_confidence >= 0 && p.found_confidence <= 1,
           "update_confidence and found_confidence must be in [0, 1]");
   require(p.confidence_rate > 0 && p.confidence_rate <= 1, "confidence_rate must be in (0, 1]");
@@ -89,6 +90,7 @@ void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   centre_ = {box.x + box.width / 2, box.y + box.height / 2};
   scale_ = 1;
   lost_ = false;
+  lost_count_ = 0;
   low_frames_ = 0;
   mean_prominence_ = 0;
   scored_frames_ = 0;
@@ -277,7 +279,8 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   scale_ = std::min(scale_, largest_scale());
   // Scale candidates for the classifier to choose from (the first is searched).
   std::vector<double> scales = {scale_};
-  const bool flow = params_.scale_estimation == "flow" || params_.scale_estimation == "hybrid";
+  const bool flow_scale_on = params_.scale_estimation == "flow" || params_.scale_estimation == "hybrid";
+  const bool flow = flow_scale_on || params_.flow_prediction;
   if (params_.scale_estimation == "classifier") {
     scales.push_back(scale_ / params_.scale_step);
     scales.push_back(scale_ * params_.scale_step);
@@ -286,27 +289,34 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
     const cv::Size2d size = init_size_ * scale_;
     const FlowScale f = flow_scale(previous_gray_, gray,
                                    {centre_.x - size.width / 2, centre_.y - size.height / 2, size.width, size.height});
-    if (f.ok) {
+    if (f.ok && flow_scale_on) {
       const double s = std::clamp(scale_ * std::clamp(f.ratio, 1 / params_.max_scale_change, params_.max_scale_change),
                                   params_.min_scale, largest_scale());
       if (params_.scale_estimation == "flow") scales[0] = scale_ = s; else scales.push_back(s);
     }
+    if (f.ok && params_.flow_prediction) {
+      centre_ += f.shift;
+      centre_.x = std::clamp(centre_.x, 0.0, frame_size_.width - 1.0);
+      centre_.y = std::clamp(centre_.y, 0.0, frame_size_.height - 1.0);
+    }
   }
   if (flow) gray.copyTo(previous_gray_);
-  if (!lost_) {
-    // Region that the search, the scale candidates and the training samples can reach.
-    const int top = levels() - 1;
-    const double search = top == 0 ? params_.search_radius
-                                   : std::max(params_.coarse_radius * (1 << top), params_.max_radius * (1 << (top - 1)));
-    const double reach = search + params_.neg_outer + (2 << top) + 2;
-    const cv::Size2d half = init_size_ * (scale_ * params_.scale_step / 2);
-    build_pyramid(frame, gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
-                                           static_cast<int>(centre_.y - half.height - reach)),
-                                 cv::Point(static_cast<int>(std::ceil(centre_.x + half.width + reach)),
-                                           static_cast<int>(std::ceil(centre_.y + half.height + reach)))));
-  } else {
-    build_pyramid(frame, gray, {0, 0, gray.cols, gray.rows});
+  // Region that the search, the scale candidates and the training samples can reach; while
+  // lost, the re-detection scan region (the whole frame, or redetect_radius doubled per lost frame).
+  const int top = levels() - 1;
+  const double radius = top == 0 ? params_.search_radius
+                                 : std::max(params_.coarse_radius * (1 << top), params_.max_radius * (1 << (top - 1)));
+  double reach = radius + params_.neg_outer + (2 << top) + 2;
+  if (lost_) {
+    reach = params_.redetect_radius > 0 ? reach + params_.redetect_radius * std::pow(2.0, std::min(lost_count_, 16))
+                                        : frame_size_.width + frame_size_.height;
+    ++lost_count_;
   }
+  const cv::Size2d half = init_size_ * (scale_ * params_.scale_step / 2);
+  build_pyramid(frame, gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
+                                         static_cast<int>(centre_.y - half.height - reach)),
+                               cv::Point(static_cast<int>(std::ceil(centre_.x + half.width + reach)),
+                                         static_cast<int>(std::ceil(centre_.y + half.height + reach)))));
   Search s = search(lost_);
   state.levels = std::move(s.levels);
   if (!s.ok) {
@@ -338,7 +348,10 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
       confident_frame();
     } else {
       drift();
-      if (params_.redetection && low_frames_ >= params_.lost_frames) lost_ = true;
+      if (params_.redetection && low_frames_ >= params_.lost_frames) {
+        lost_ = true;
+        lost_count_ = 0;
+      }
     }
   } else if (conf >= params_.found_confidence) {  // lost, found again
     lost_ = false;
