@@ -317,20 +317,24 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
                                          static_cast<int>(centre_.y - half.height - reach)),
                                cv::Point(static_cast<int>(std::ceil(centre_.x + half.width + reach)),
                                          static_cast<int>(std::ceil(centre_.y + half.height + reach)))));
-  Search s = search(lost_);
+  // While lost, the target is still searched around its last location (an uncertain
+  // stretch is often the target itself changing) and the scan proposes a re-detection.
+  Search s = search(false);
+  Search scan;
+  scan.ok = false;
+  if (lost_) scan = search(true);
   state.levels = std::move(s.levels);
-  if (!s.ok) {
+  if (lost_) state.levels.insert(state.levels.end(), scan.levels.begin(), scan.levels.end());
+  if (!s.ok && !scan.ok) {
     state.pose = {centre_.x, centre_.y, scale_, 0.0};
     state.lost = true;
     return state;
   }
-  const cv::Point2d previous = centre_;
-  const double previous_scale = scale_;
-  centre_ = s.centre;
-  if (scales.size() > 1 && !lost_) adapt_scale(s.centre, scales);
   // Confidence: the prominence of the best sample relative to its running mean while tracking well.
-  const double z = s.prominence;
-  const double conf = scored_frames_ == 0 ? 1.0 : std::clamp(z / std::max(mean_prominence_, 1e-6), 0.0, 1.0);
+  auto confidence = [&](const Search& r) {
+    return scored_frames_ == 0 ? 1.0 : std::clamp(r.prominence / std::max(mean_prominence_, 1e-6), 0.0, 1.0);
+  };
+  double z = s.prominence, conf = s.ok ? confidence(s) : 0.0;
   auto confident_frame = [&] {
     const double rate = std::max(params_.confidence_rate, 1.0 / ++scored_frames_);
     mean_prominence_ += rate * (z - mean_prominence_);
@@ -341,6 +345,8 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   auto drift = [&] { mean_prominence_ += 0.25 * params_.confidence_rate * (z - mean_prominence_); };
 
   if (!lost_) {
+    centre_ = s.centre;
+    if (scales.size() > 1) adapt_scale(s.centre, scales);
     // Hysteresis: once below update_confidence, learning resumes only at found_confidence.
     const bool uncertain = low_frames_ > 0 ? conf < params_.found_confidence : conf < params_.update_confidence;
     low_frames_ = uncertain ? low_frames_ + 1 : 0;
@@ -353,15 +359,23 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
         lost_count_ = 0;
       }
     }
-  } else if (conf >= params_.found_confidence) {  // lost, found again
-    lost_ = false;
-    low_frames_ = 0;
-    state.redetected = true;
-    confident_frame();
   } else {
-    drift();
-    centre_ = previous;  // still lost: report where the target was last seen
-    scale_ = previous_scale;
+    // A re-detection elsewhere must score above the local search and reach found_confidence.
+    const double conf_scan = scan.ok ? confidence(scan) : 0.0;
+    const bool redetected = conf_scan >= params_.found_confidence && (!s.ok || scan.score > s.score);
+    if (redetected) {
+      z = scan.prominence;
+      conf = conf_scan;
+      state.redetected = true;
+    }
+    if (s.ok || redetected) centre_ = redetected ? scan.centre : s.centre;
+    if (redetected || conf >= params_.found_confidence) {  // found again
+      lost_ = false;
+      low_frames_ = 0;
+      confident_frame();
+    } else {
+      drift();
+    }
   }
   state.pose = {centre_.x, centre_.y, scale_, 0.0};
   state.confidence = conf;

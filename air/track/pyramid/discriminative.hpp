@@ -77,13 +77,13 @@ struct DiscriminativeParams {
   // Motion prediction: the search is centred on the previous location moved by the median
   // flow of the points in the box (the same Lucas-Kanade points as the flow scale), so that
   // fast motion stays inside the search radius; the classifier still decides.
-  bool flow_prediction = false;
+  bool flow_prediction = true;
   // Occlusion, loss and re-detection. The confidence of a frame is the prominence of its best
   // sample over the coarsest level's search (best minus median score, per term) relative to the
   // running mean of that prominence over the frames tracked with confidence.
   double update_confidence = 0.5;  // below it the classifiers are not updated (occlusion, clutter)
   double confidence_rate = 0.05;   // weight of a new frame in the running mean
-  bool redetection = true;
+  bool redetection = false;        // off by default: it lowered the mean AUC (docs/results/track.md)
   int lost_frames = 3;             // frames in a row below update_confidence -> lost
   double found_confidence = 0.7;   // a re-detection scan result at least this -> re-detected
   int redetect_stride = 8;         // grid step of the scan, full-resolution pixels

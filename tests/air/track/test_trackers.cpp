@@ -70,6 +70,33 @@ TEST_P(TrackerFollows, FastMotionWithFlowPrediction) {
   }
 }
 
+// The target jumps 112 px away (beyond any search radius) after 10 frames: with re-detection
+// the tracker declares it lost, scans the frame and finds it again; without, it stays behind.
+// Known limitation: single-resolution CT finds the target in the scan (highest score) but its
+// confidence stays below found_confidence, so it is not accepted (docs/results/track.md).
+TEST_P(TrackerFollows, RedetectionAfterAJump) {
+  if (std::string(GetParam()) == "ct") GTEST_SKIP() << "CT's re-detection confidence stays below found_confidence";
+  const Scene scene({320, 240}, {40, 32});
+  const auto m = path(30, [](Motion& m, int i) {
+    m.centre += cv::Point2d(1, 0.5);
+    if (i == 10) m.centre += cv::Point2d(100, 50);
+  });
+  auto t = make_tracker(GetParam(), aerie::util::Config::parse("{redetection: true}"), 3);
+  t->init(scene.render(m[0]), scene.box(m[0]));
+  int lost = 0, redetected = 0;
+  double final_error = 0;
+  for (size_t i = 1; i < m.size(); ++i) {
+    const TrackState s = t->update(scene.render(m[i]));
+    lost += s.lost;
+    redetected += s.redetected;
+    final_error = std::hypot(s.pose.x - m[i].centre.x, s.pose.y - m[i].centre.y);
+  }
+  EXPECT_GE(lost, 1);
+  EXPECT_EQ(redetected, 1);
+  EXPECT_LT(final_error, 4.0);
+  EXPECT_GT(follow(GetParam(), scene, m, "{redetection: false}").max_error, 100.0);
+}
+
 // In-plane rotation by 2 degrees per frame (to 60 degrees) while drifting: the centre is followed.
 TEST_P(TrackerFollows, Rotation) {
   const Scene scene({240, 180}, {40, 32});
