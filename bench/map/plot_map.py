@@ -33,7 +33,8 @@ def throughput(src, dst):
         ax.text(x + 0.2, float(row["ours_mpts_s"]), f"x{float(row['speedup']):.1f}", ha="center", va="bottom", fontsize=8)
     ax.set_xticks(list(xs))
     ax.set_xticklabels(labels, fontsize=7)
-    ax.set_ylabel("M points / s (single thread)")
+    ax.set_yscale("log")
+    ax.set_ylabel("M points / s of thread CPU time (log)")
     ax.set_title("Insertion throughput (resolution / max range)")
     ax.legend()
     fig.tight_layout()
@@ -42,6 +43,8 @@ def throughput(src, dst):
 
 def quality(src, dst):
     for path in sorted(glob.glob(os.path.join(src, "quality_*.csv"))):
+        if path.endswith("_study.csv"):  # parameter studies: robust update only
+            continue
         r = rows(path)
         name = os.path.splitext(os.path.basename(path))[0]
         res = sorted({float(x["resolution_m"]) for x in r})
@@ -71,13 +74,20 @@ def bandwidth(src, dst):
         return
     r = rows(path)
     fig, ax = plt.subplots(figsize=(7, 4))
+    styles = iter([("o", "-", 9), ("s", "--", 7), ("^", ":", 5), ("x", "-.", 5)])
     for image in sorted({x["image"] for x in r}):
         for depth in ["exact", "sgbm"]:
             sel = [x for x in r if x["image"] == image and x["depth"] == depth]
             if not sel:
                 continue
-            ax.plot([float(x["bin_deg"]) for x in sel], [float(x["vo_depth_bytes_mean"]) / 1024 for x in sel], "o-",
+            marker, line, size = next(styles, ("o", "-", 4))
+            ax.plot([float(x["bin_deg"]) for x in sel], [float(x["vo_depth_bytes_mean"]) / 1024 for x in sel],
+                    marker=marker, linestyle=line, markersize=size, fillstyle="none",
                     label=f"VO_DEPTH {image} ({depth} depth)")
+            if depth == "exact":  # compression against this image's raw disparity
+                for x in sel:
+                    ax.annotate(f"x{float(x['ratio']):.1f}", (float(x["bin_deg"]), float(x["vo_depth_bytes_mean"]) / 1024),
+                                textcoords="offset points", xytext=(6, 4 if image.startswith("3") else -12), fontsize=7)
         raw = float(next(x["raw_disparity_bytes"] for x in r if x["image"] == image))
         ax.axhline(raw / 1024, linestyle="--", color="gray")
         ax.text(0.3, raw / 1024 * 1.05, f"raw 16-bit disparity {image}", fontsize=8, color="gray")
@@ -85,7 +95,7 @@ def bandwidth(src, dst):
     ax.set_yscale("log")
     ax.set_xlabel("spherical bin (deg)")
     ax.set_ylabel("KiB per frame")
-    ax.set_title("Depth bandwidth: VO_DEPTH vs raw disparity")
+    ax.set_title("Depth bandwidth: VO_DEPTH vs raw disparity\n(x: compression vs 376x240 above the curve, vs 752x480 below)", fontsize=10)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(os.path.join(dst, "map_bandwidth.png"), dpi=110)

@@ -30,26 +30,30 @@ unsigned child_index(uint64_t packed, unsigned bit) {
 
 }  // namespace
 
-void sort_tree_order(std::vector<VoxelUpdate>& updates) {
+void sort_tree_order(std::vector<VoxelUpdate>& updates, std::vector<MortonUpdate>& scratch) {
   constexpr int kBits = 12, kPasses = 4;  // 48-bit codes
   constexpr size_t kBuckets = size_t{1} << kBits;
   const size_t n = updates.size();
   if (n < 2) return;
-  std::vector<std::pair<uint64_t, VoxelUpdate>> a(n), b(n);
+  scratch.resize(2 * n);
+  MortonUpdate* a = scratch.data();
+  MortonUpdate* b = a + n;
   for (size_t i = 0; i < n; ++i) a[i] = {morton(updates[i].key), updates[i]};
   std::array<size_t, kBuckets> count{};
   for (int pass = 0; pass < kPasses; ++pass) {
     const int shift = pass * kBits;
     count.fill(0);
-    for (const auto& e : a) ++count[(e.first >> shift) & (kBuckets - 1)];
+    for (size_t i = 0; i < n; ++i) ++count[(a[i].first >> shift) & (kBuckets - 1)];
+    // A digit that all keys share (the high bits of a local frame) needs no pass.
+    if (count[(a[0].first >> shift) & (kBuckets - 1)] == n) continue;
     size_t sum = 0;
     for (auto& c : count) {
       const size_t t = c;
       c = sum;
       sum += t;
     }
-    for (const auto& e : a) b[count[(e.first >> shift) & (kBuckets - 1)]++] = e;
-    a.swap(b);
+    for (size_t i = 0; i < n; ++i) b[count[(a[i].first >> shift) & (kBuckets - 1)]++] = a[i];
+    std::swap(a, b);
   }
   for (size_t i = 0; i < n; ++i) updates[i] = a[i].second;
 }

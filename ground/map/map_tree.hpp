@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace aerie::map {
@@ -29,8 +30,9 @@ struct VoxelUpdate {
 
 // Sorts updates into the order of a depth-first traversal of the tree (child index
 // x | y << 1 | z << 2 at every level, from the root): an LSD radix sort on the 48-bit
-// Morton code, O(n).
-void sort_tree_order(std::vector<VoxelUpdate>& updates);
+// Morton code, O(n), in `scratch` (kept by the caller between frames: no allocation).
+using MortonUpdate = std::pair<uint64_t, VoxelUpdate>;
+void sort_tree_order(std::vector<VoxelUpdate>& updates, std::vector<MortonUpdate>& scratch);
 
 class MapTree : public octomap::OcTree {
  public:

@@ -120,6 +120,7 @@ struct OccupancyMap::FrameBuffer {
   std::vector<Ray> rays;        // hits first
   VoxelMarks voxels;            // voxels that already have an update
   std::vector<VoxelUpdate> updates;
+  std::vector<MortonUpdate> sort_scratch;
 
   void reset(const octomap::OcTreeKey& origin, int half_extent) {
     constexpr size_t kMaxWords = size_t{1} << 22;  // 32 MiB per grid at most
@@ -304,7 +305,7 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
   auto saturated = [&](float log_odds, const VoxelUpdate& u) {
     return u.occupancy > 0.f ? log_odds >= log_max : log_odds <= log_min;
   };
-  sort_tree_order(f.updates);
+  sort_tree_order(f.updates, f.sort_scratch);
   const auto batch = tree_->apply_batch(f.updates, leaf_update, saturated);
   stats.skipped = batch.leaves_skipped;
   stats.state_changes = batch.state_changes;

@@ -2,12 +2,13 @@
 
 namespace aerie::viewer {
 
-Layout Layout::create(int width, int height, bool offscreen) {
+Layout Layout::create(int width, int height, bool offscreen, int multisamples) {
   Layout l;
   l.window = vtkSmartPointer<vtkRenderWindow>::New();
   l.window->SetSize(width, height);
   l.window->SetWindowName("Aerie ground viewer");
   if (offscreen) l.window->SetOffScreenRendering(1);
+  l.window->SetMultiSamples(multisamples);
   auto make = [&](double x0, double y0, double x1, double y1, double r, double g, double b) {
     auto ren = vtkSmartPointer<vtkRenderer>::New();
     ren->SetViewport(x0, y0, x1, y1);

@@ -20,7 +20,7 @@ struct Layout {
   std::array<vtkSmartPointer<vtkRenderer>, static_cast<size_t>(ChartSlot::Count)> charts;
 
   vtkRenderer* chart(ChartSlot s) const { return charts[static_cast<size_t>(s)]; }
-  static Layout create(int width, int height, bool offscreen);
+  static Layout create(int width, int height, bool offscreen, int multisamples = 0);
 };
 
 }  // namespace aerie::viewer

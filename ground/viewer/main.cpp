@@ -44,6 +44,16 @@ int main(int argc, char** argv) {
   app.add_option("--after", after, "with --snapshot: seconds after start to write it, then exit");
   app.add_option("--record", record_dir, "write one PNG of the window per second into this folder");
   app.add_option("--fps", fps, "display frames per second")->capture_default_str()->check(CLI::Range(1.0, 200.0));
+  app.add_option("--pane-fps", opts.pane_fps,
+                 "at most this many redraws per second of the 3D scene, charts and panel (when they change)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 200.0));
+  app.add_option("--map-max-quads", opts.map_max_quads,
+                 "show the OctoMap one level coarser while its surface needs more quads than this (0: no limit)")
+      ->capture_default_str();
+  app.add_option("--multisamples", opts.multisamples, "OpenGL anti-aliasing samples (0: off, best without a GPU)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
   app.add_option("--duration", duration, "exit after this many seconds (headless runs)");
   app.add_option("--disable", disable, "renderers to start disabled (by name, e.g. octomap chart-latency)");
   CLI11_PARSE(app, argc, argv);

@@ -9,6 +9,8 @@
 
 #include "common/bus/bus.hpp"
 
+class vtkRenderer;
+
 namespace aerie::viewer {
 
 struct Layout;
@@ -39,13 +41,18 @@ class Renderer {
   virtual int64_t latest_utime() const { return 0; }
   // Render thread: a key the viewer does not use itself; true when handled.
   virtual bool on_key(const std::string&) { return false; }
+  // The window pane this renderer draws into (set by attach); nullptr for overlays on the
+  // camera image. The viewer redraws a pane only when one of its renderers changed.
+  vtkRenderer* pane() const { return pane_; }
 
  protected:
   virtual void on_enabled(bool) {}
+  void draws_in(vtkRenderer* pane) { pane_ = pane; }
 
  private:
   std::string name_;
   std::atomic<bool> enabled_{true};
+  vtkRenderer* pane_ = nullptr;
 };
 
 }  // namespace aerie::viewer

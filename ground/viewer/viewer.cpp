@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 #include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
 #include <vtkCommand.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkObjectFactory.h>
@@ -14,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/bus/node.hpp"
+#include "common/util/time.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -27,7 +29,12 @@ struct Viewer::Help {
 Viewer::Viewer(bus::Bus& bus, ViewerOptions options)
     : bus_(bus), options_(std::move(options)), help_(std::make_unique<Help>()) {
   if (options_.trackers.empty()) throw std::invalid_argument("viewer: the tracker menu is empty");
-  layout_ = Layout::create(options_.width, options_.height, options_.offscreen);
+  if (!(options_.pane_fps > 0)) throw std::invalid_argument("viewer: pane_fps must be positive");
+  layout_ = Layout::create(options_.width, options_.height, options_.offscreen, options_.multisamples);
+  panes_.push_back({layout_.image});
+  panes_.push_back({layout_.scene});
+  panes_.push_back({layout_.panel});
+  for (const auto& chart : layout_.charts) panes_.push_back({chart});
   image_pane_ = std::make_unique<ImagePane>(layout_.image);
   help_->text->GetTextProperty()->SetFontSize(13);
   help_->text->GetTextProperty()->SetColor(1, 1, 0.6);
@@ -54,7 +61,7 @@ void Viewer::add_default_renderers() {
   add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false));
   add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true));
   add(std::make_unique<DepthCloudRenderer>());
-  add(std::make_unique<OctomapRenderer>());
+  add(std::make_unique<OctomapRenderer>("MAP_OCTOMAP", options_.map_max_quads));
   add(std::make_unique<TargetPoseRenderer>());
   add_default_charts(*this);
   add(std::make_unique<ProcmanPanel>());
@@ -92,7 +99,7 @@ int64_t Viewer::message_time() const {
   return t;
 }
 
-void Viewer::compose_image_pane(bool force) {
+bool Viewer::compose_image_pane(bool force) {
   bool changed = force;
   if (camera_ && camera_->enabled()) {
     cv::Mat img;
@@ -101,7 +108,7 @@ void Viewer::compose_image_pane(bool force) {
       changed = true;
     }
   }
-  if (!changed || base_image_.empty()) return;
+  if (!changed || base_image_.empty()) return false;
   cv::Mat canvas;
   if (base_image_.channels() == 1)
     cv::cvtColor(base_image_, canvas, cv::COLOR_GRAY2BGR);
@@ -111,22 +118,76 @@ void Viewer::compose_image_pane(bool force) {
     if (r->enabled() && r.get() != camera_) r->draw_image(canvas);
   if (selection_) cv::rectangle(canvas, *selection_, cv::Scalar(255, 255, 0), 1);
   image_pane_->show(canvas);
+  return true;
+}
+
+namespace {
+std::array<double, 11> view_of(vtkRenderer* pane) {
+  vtkCamera* c = pane->GetActiveCamera();
+  std::array<double, 11> v{};
+  c->GetPosition(&v[0]);
+  c->GetFocalPoint(&v[3]);
+  c->GetViewUp(&v[6]);
+  v[9] = c->GetViewAngle();
+  v[10] = c->GetParallelScale();
+  return v;
+}
+}  // namespace
+
+bool Viewer::schedule_panes(bool image_changed, const std::vector<vtkRenderer*>& changed) {
+  const int* size = layout_.window->GetSize();
+  if (size[0] != window_size_[0] || size[1] != window_size_[1]) redraw_all_ = true;
+  window_size_ = {size[0], size[1]};
+  const double now = util::mono_ms() / 1000.0;
+  bool any = false;
+  for (auto& s : panes_) {
+    const bool is_image = s.pane == layout_.image.Get();
+    s.pending = s.pending || (is_image ? image_changed : std::count(changed.begin(), changed.end(), s.pane) > 0);
+    // A pane is drawn when its view moved (interaction) at once, when its content changed
+    // at most pane_fps times a second, the camera image with every new frame.
+    const double interval = std::max(1.0 / options_.pane_fps, 2.0 * s.cost_s);
+    const bool due = redraw_all_ || options_.always_redraw || view_of(s.pane) != s.view ||
+                     (s.pending && (is_image || now - s.last_drawn_s >= interval));
+    s.pane->SetDraw(due);
+    if (due) {
+      s.pending = false;
+      s.last_drawn_s = now;
+    }
+    any = any || due;
+  }
+  redraw_all_ = false;
+  return any;
 }
 
 bool Viewer::render_frame() {
   bool overlay_changed = selection_.has_value();
   bool changed = false;
+  std::vector<vtkRenderer*> changed_panes;
   for (auto& r : renderers_) {
     if (!r->enabled() || r.get() == camera_) continue;
     if (r->update()) {
       changed = true;
-      overlay_changed = true;  // cheap to redraw; overlays are few
+      if (r->pane())
+        changed_panes.push_back(r->pane());
+      else
+        overlay_changed = true;
     }
   }
   if (paused_) return false;
-  compose_image_pane(overlay_changed);
-  layout_.window->Render();
-  ++frames_rendered_;
+  const bool image_changed = compose_image_pane(overlay_changed);
+  if (schedule_panes(image_changed, changed_panes)) {
+    // Panes not due keep their pixels: VTK renders into its own framebuffer and each
+    // renderer clears only its viewport.
+    const double start = util::mono_ms();
+    layout_.window->Render();
+    const double cost_s = (util::mono_ms() - start) / 1000.0;
+    ++frames_rendered_;
+    for (auto& s : panes_) {
+      s.view = view_of(s.pane);
+      if (s.pane->GetDraw()) s.cost_s = cost_s;
+    }
+  }
+  for (auto& s : panes_) s.pane->SetDraw(true);  // interactor renders and snapshots draw all
   return changed;
 }
 
@@ -215,6 +276,7 @@ void Viewer::on_key(const std::string& key) {
       if (r->enabled() && r->on_key(key)) break;
   }
   update_help_text();
+  redraw_all();
 }
 
 void Viewer::update_help_text() {

@@ -5,6 +5,7 @@
 // to stop/reset tracking, toggle renderers, reset the camera and pause the display.
 #include <aerie/track_cmd_t.hpp>
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -24,6 +25,18 @@ struct ViewerOptions {
   int width = 1280;
   int height = 800;
   bool offscreen = false;
+  // OpenGL multisampling (anti-aliasing). Off by default: software OpenGL (llvmpipe, no
+  // GPU) spends most of a frame resolving 8 samples per pixel.
+  int multisamples = 0;
+  // Panes other than the camera image (3D scene, charts, panel) are redrawn when their
+  // content or view changed, at most this many times per second and at most half of
+  // the time (a pane whose frame took 80 ms waits 160 ms), so a large map never starves
+  // the camera pane, which is redrawn with every new image. `always_redraw` draws every
+  // pane every frame.
+  double pane_fps = 10;
+  bool always_redraw = false;
+  // OctoMap display: more quads than this and the map is shown one level coarser (0: no limit).
+  size_t map_max_quads = 40000;
   std::string image_channel = "CAM_LEFT";
   std::string track_cmd_channel = "TRACK_CMD";
   std::vector<std::string> trackers = {"amcmr-ct", "am3", "ipsl-mr", "ct", "mil", "ipsl"};
@@ -45,8 +58,10 @@ class Viewer {
   void stop();
 
   // Render thread: pulls the latest data into every enabled renderer and renders the
-  // window (unless paused). Returns true when anything changed.
+  // panes that changed (unless paused). Returns true when anything changed.
   bool render_frame();
+  // Draw every pane at the next frame (after keys, window resizes).
+  void redraw_all() { redraw_all_ = true; }
   // Writes a PNG of the whole window (renders first).
   void snapshot(const std::string& png_path);
 
@@ -71,7 +86,10 @@ class Viewer {
   void run_interactive(double fps);
 
  private:
-  void compose_image_pane(bool force);
+  // Redraws the camera pane's image when a new image arrived or `force`; true when it did.
+  bool compose_image_pane(bool force);
+  // Chooses the panes due for drawing (vtkRenderer::SetDraw); false when none is.
+  bool schedule_panes(bool image_changed, const std::vector<vtkRenderer*>& changed);
   void update_help_text();
 
   bus::Bus& bus_;
@@ -86,6 +104,16 @@ class Viewer {
   size_t tracker_index_ = 0;
   bool paused_ = false;
   int64_t frames_rendered_ = 0;
+  struct PaneState {
+    vtkRenderer* pane;
+    bool pending = true;            // content changed since it was last drawn
+    double last_drawn_s = -1e9;     // monotonic seconds
+    double cost_s = 0;              // wall time of the last frame that drew it
+    std::array<double, 11> view{};  // camera when last drawn: an interaction moved it if different
+  };
+  std::vector<PaneState> panes_;  // the camera image pane first
+  std::array<int, 2> window_size_{};
+  bool redraw_all_ = true;
   int64_t cmd_seq_ = 0;
   std::atomic<bool> running_{false};
   std::thread lcm_thread_;

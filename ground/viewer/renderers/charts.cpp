@@ -34,6 +34,7 @@ ChartRenderer::ChartRenderer(std::string name, ChartSlot slot, std::string title
       series_(std::move(series)) {}
 
 void ChartRenderer::attach(Layout& layout) {
+  draws_in(layout.chart(slot_));
   chart_ = vtkSmartPointer<vtkChartXY>::New();
   chart_->SetTitle(title_);
   chart_->GetTitleProperties()->SetFontSize(12);

@@ -37,6 +37,7 @@ void ProcmanPanel::subscribe(bus::Bus& bus) {
 }
 
 void ProcmanPanel::attach(Layout& layout) {
+  draws_in(layout.panel);
   actor_ = vtkSmartPointer<vtkTextActor>::New();
   actor_->GetTextProperty()->SetFontFamilyToCourier();
   actor_->GetTextProperty()->SetFontSize(11);

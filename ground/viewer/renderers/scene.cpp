@@ -5,11 +5,8 @@
 #include <vtkAxesActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
-#include <vtkCubeSource.h>
 #include <vtkFloatArray.h>
-#include <vtkGlyph3DMapper.h>
 #include <vtkLookupTable.h>
-#include <vtkCellData.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -17,12 +14,19 @@
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkSphereSource.h>
+#include <vtkTextProperty.h>
 
+#include <cstdio>
+#include <condition_variable>
+#include <deque>
 #include <mutex>
+#include <optional>
+#include <thread>
 #include <sstream>
 
 #include "common/spherical/spherical_message.hpp"
 #include "ground/viewer/layout.hpp"
+#include "ground/viewer/voxel_mesh.hpp"
 
 namespace aerie::viewer {
 namespace {
@@ -64,6 +68,7 @@ GridRenderer::GridRenderer(double half_size_m, double spacing_m)
     : Renderer("grid"), half_(half_size_m), spacing_(spacing_m) {}
 
 void GridRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   grid_ = line_actor(0.45, 0.45, 0.5, 1);
   auto pts = vtkSmartPointer<vtkPoints>::New();
   auto lines = vtkSmartPointer<vtkCellArray>::New();
@@ -113,6 +118,7 @@ void PoseRenderer::subscribe(bus::Bus& bus) {
 }
 
 void PoseRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   // Ground truth in green, the estimate in orange.
   const double r = gt_ ? 0.2 : 1.0, g = gt_ ? 0.9 : 0.55, b = gt_ ? 0.3 : 0.1;
   path_ = line_actor(r, g, b, 2);
@@ -170,6 +176,7 @@ void DepthCloudRenderer::subscribe(bus::Bus& bus) {
 }
 
 void DepthCloudRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   actor_ = line_actor(0.3, 0.9, 1.0, 1);
   actor_->GetProperty()->SetPointSize(2);
   layout.scene->AddActor(actor_);
@@ -199,15 +206,83 @@ void DepthCloudRenderer::on_enabled(bool on) {
 }
 
 // ---------------------------------------------------------------- octomap
+// The map is merged and meshed by a thread of its own, so that neither the LCM thread
+// nor the render thread waits for a large map (100k voxels take ~100 ms to mesh).
 struct OctomapRenderer::Map {
+  struct Surface {
+    VoxelMesh mesh;
+    double zmin = 0, zmax = 1, resolution = 0;
+    int coarsening_shown = 0;
+  };
   std::mutex m;
-  std::unique_ptr<octomap::OcTree> tree;
-  uint64_t version = 0;
+  std::condition_variable wake;
+  std::deque<std::pair<std::unique_ptr<octomap::OcTree>, bool>> inbox;  // parsed messages, full?
+  int coarsening = 0;
+  size_t max_quads = 0;
+  uint64_t settings = 1;  // bumped when coarsening or max_quads change
+  bool stop = false;
+  std::optional<Surface> ready;  // the newest surface, until the render thread takes it
+  std::thread mesher;
+
+  void run();
 };
 
-OctomapRenderer::OctomapRenderer(std::string channel)
-    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()) {}
-OctomapRenderer::~OctomapRenderer() = default;
+void OctomapRenderer::Map::run() {
+  std::unique_ptr<octomap::OcTree> tree;
+  uint64_t meshed_settings = 0;
+  for (;;) {
+    std::deque<std::pair<std::unique_ptr<octomap::OcTree>, bool>> messages;
+    int levels = 0;
+    size_t budget = 0;
+    {
+      std::unique_lock lock(m);
+      wake.wait(lock, [&] { return stop || !inbox.empty() || settings != meshed_settings; });
+      if (stop) return;
+      messages.swap(inbox);
+      levels = coarsening;
+      budget = max_quads;
+      meshed_settings = settings;
+    }
+    for (auto& [incoming, full] : messages) {
+      if (full || !tree || tree->getResolution() != incoming->getResolution()) {
+        tree = std::move(incoming);
+      } else {
+        // A changed region: its leaves (occupied and free) overwrite the local copy.
+        for (auto it = incoming->begin_leafs(); it != incoming->end_leafs(); ++it)
+          tree->setNodeValue(it.getCoordinate(), it->getLogOdds(), true);
+      }
+    }
+    if (!tree) continue;
+    Surface s;
+    double lo[3], hi[3];
+    tree->getMetricMin(lo[0], lo[1], lo[2]);
+    tree->getMetricMax(hi[0], hi[1], hi[2]);
+    s.zmin = lo[2];
+    s.zmax = std::max(hi[2], s.zmin + 1e-3);
+    s.coarsening_shown = levels;
+    s.mesh = mesh_occupied_surface(*tree, levels);
+    while (budget > 0 && s.mesh.quads.size() > budget && s.coarsening_shown < 4)
+      s.mesh = mesh_occupied_surface(*tree, ++s.coarsening_shown);
+    s.resolution = tree->getNodeSize(tree->getTreeDepth() - static_cast<unsigned>(s.coarsening_shown));
+    std::lock_guard lock(m);
+    ready = std::move(s);
+  }
+}
+
+OctomapRenderer::OctomapRenderer(std::string channel, size_t max_quads)
+    : Renderer("octomap"), channel_(std::move(channel)), map_(std::make_unique<Map>()) {
+  map_->max_quads = max_quads;
+  map_->mesher = std::thread([this] { map_->run(); });
+}
+
+OctomapRenderer::~OctomapRenderer() {
+  {
+    std::lock_guard lock(map_->m);
+    map_->stop = true;
+  }
+  map_->wake.notify_all();
+  map_->mesher.join();
+}
 
 namespace {
 std::unique_ptr<octomap::OcTree> parse_octree(const aerie::octomap_t& m) {
@@ -232,24 +307,22 @@ void OctomapRenderer::subscribe(bus::Bus& bus) {
   bus.subscribe<aerie::octomap_t>(
       channel_,
       [this](const aerie::octomap_t& m, const bus::ReceiveInfo&) {
-        auto incoming = parse_octree(m);  // parse outside the lock
-        std::lock_guard lock(map_->m);
-        if (m.full || !map_->tree || map_->tree->getResolution() != incoming->getResolution()) {
-          map_->tree = std::move(incoming);
-        } else {
-          // A changed region: its leaves (occupied and free) overwrite the local copy.
-          for (auto it = incoming->begin_leafs(); it != incoming->end_leafs(); ++it)
-            map_->tree->setNodeValue(it.getCoordinate(), it->getLogOdds(), true);
+        auto incoming = parse_octree(m);  // a malformed message throws here and is counted
+        {
+          std::lock_guard lock(map_->m);
+          map_->inbox.emplace_back(std::move(incoming), m.full);
         }
-        ++map_->version;
+        map_->wake.notify_one();
       },
       4);
 }
 
 void OctomapRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
   mapper->SetInputData(vtkSmartPointer<vtkPolyData>::New());
-  mapper->SetScalarModeToUseCellData();
+  mapper->SetScalarModeToUsePointData();
+  mapper->InterpolateScalarsBeforeMappingOn();  // height colours per pixel, not per corner
   mapper->ScalarVisibilityOn();
   auto lut = vtkSmartPointer<vtkLookupTable>::New();
   lut->SetHueRange(0.667, 0.0);  // blue (low) to red (high)
@@ -257,12 +330,32 @@ void OctomapRenderer::attach(Layout& layout) {
   mapper->SetLookupTable(lut);
   actor_ = vtkSmartPointer<vtkActor>::New();
   actor_->SetMapper(mapper);
+  actor_->GetProperty()->BackfaceCullingOn();  // the quads face out of the occupied space
   layout.scene->AddActor(actor_);
+  label_ = vtkSmartPointer<vtkTextActor>::New();
+  label_->GetTextProperty()->SetFontSize(12);
+  label_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
+  label_->SetPosition(6, 6);
+  layout.scene->AddActor2D(label_);
+}
+
+void OctomapRenderer::set_max_quads(size_t n) {
+  {
+    std::lock_guard lock(map_->m);
+    map_->max_quads = n;
+    ++map_->settings;
+  }
+  map_->wake.notify_one();
 }
 
 void OctomapRenderer::set_coarsening(int levels) {
   coarsening_ = std::clamp(levels, 0, 4);
-  dirty_ = true;
+  {
+    std::lock_guard lock(map_->m);
+    map_->coarsening = coarsening_;
+    ++map_->settings;
+  }
+  map_->wake.notify_one();
 }
 
 bool OctomapRenderer::on_key(const std::string& key) {
@@ -271,76 +364,53 @@ bool OctomapRenderer::on_key(const std::string& key) {
   return true;
 }
 
+// The mesher's newest surface (voxel_mesh.hpp) to VTK, coloured by height: the corners
+// carry their z, interpolated across each quad.
 bool OctomapRenderer::update() {
+  std::optional<Map::Surface> surface;
   {
     std::lock_guard lock(map_->m);
-    if (map_->version == seen_ && !dirty_) return false;
-    seen_ = map_->version;
+    surface.swap(map_->ready);
   }
-  dirty_ = false;
-  extract();
-  return true;
-}
-
-// Occupied voxels as one mesh of their visible faces: a face shared with another
-// occupied voxel is never seen and is left out, which keeps a 100k-voxel map to a few
-// hundred thousand triangles that software OpenGL draws at display rate.
-void OctomapRenderer::extract() {
+  if (!surface) return false;
+  const VoxelMesh& mesh = surface->mesh;
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToFloat();
-  auto quads = vtkSmartPointer<vtkCellArray>::New();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.points.size()));
   auto height = vtkSmartPointer<vtkFloatArray>::New();
   height->SetName("height");
-  double zmin = 0, zmax = 1;
-  size_t voxels = 0;
-  {
-    std::lock_guard lock(map_->m);
-    if (!map_->tree) return;
-    auto& tree = *map_->tree;
-    const unsigned depth = tree.getTreeDepth() - static_cast<unsigned>(coarsening_);
-    double lo[3], hi[3];
-    tree.getMetricMin(lo[0], lo[1], lo[2]);
-    tree.getMetricMax(hi[0], hi[1], hi[2]);
-    zmin = lo[2];
-    zmax = std::max(hi[2], zmin + 1e-3);
-    static const int dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    for (auto it = tree.begin_leafs(depth); it != tree.end_leafs(); ++it) {
-      if (!tree.isNodeOccupied(*it)) continue;
-      ++voxels;
-      const auto c = it.getCoordinate();
-      const float h = static_cast<float>(it.getSize() / 2);
-      for (const auto& d : dirs) {
-        const octomap::point3d n(c.x() + d[0] * (h + 1e-3f), c.y() + d[1] * (h + 1e-3f), c.z() + d[2] * (h + 1e-3f));
-        const auto* nb = tree.search(n, depth);
-        if (nb && tree.isNodeOccupied(nb)) continue;  // hidden face
-        // The face's four corners: the two axes orthogonal to d span it.
-        const int a = d[0] ? 1 : 0, b = d[2] ? 1 : 2;
-        vtkIdType ids[4];
-        const float s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-        for (int k = 0; k < 4; ++k) {
-          float p[3] = {c.x(), c.y(), c.z()};
-          for (int axis = 0; axis < 3; ++axis) p[axis] += d[axis] * h;
-          p[a] += s[k][0] * h;
-          p[b] += s[k][1] * h;
-          ids[k] = points->InsertNextPoint(p);
-        }
-        quads->InsertNextCell(4, ids);
-        height->InsertNextValue(c.z());
-      }
-    }
+  height->SetNumberOfValues(static_cast<vtkIdType>(mesh.points.size()));
+  for (vtkIdType i = 0; i < static_cast<vtkIdType>(mesh.points.size()); ++i) {
+    const auto& p = mesh.points[static_cast<size_t>(i)];
+    points->SetPoint(i, p.data());
+    height->SetValue(i, p[2]);
+  }
+  auto quads = vtkSmartPointer<vtkCellArray>::New();
+  quads->AllocateExact(static_cast<vtkIdType>(mesh.quads.size()), static_cast<vtkIdType>(4 * mesh.quads.size()));
+  for (const auto& q : mesh.quads) {
+    const vtkIdType ids[4] = {q[0], q[1], q[2], q[3]};
+    quads->InsertNextCell(4, ids);
   }
   auto poly = vtkSmartPointer<vtkPolyData>::New();
   poly->SetPoints(points);
   poly->SetPolys(quads);
-  poly->GetCellData()->SetScalars(height);
+  poly->GetPointData()->SetScalars(height);
   auto* mapper = vtkPolyDataMapper::SafeDownCast(actor_->GetMapper());
   mapper->SetInputData(poly);
-  mapper->SetScalarRange(zmin, zmax);
-  shown_ = voxels;
+  mapper->SetScalarRange(surface->zmin, surface->zmax);
+  shown_ = mesh.voxels;
+  quads_ = mesh.quads.size();
+  shown_coarsening_ = surface->coarsening_shown;
+  char text[128];
+  std::snprintf(text, sizeof(text), "map: %zu voxels of %.2f m%s", shown_, surface->resolution,
+                shown_coarsening_ > coarsening_ ? " (coarser: quad budget)" : "");
+  label_->SetInput(text);
+  return true;
 }
 
 void OctomapRenderer::on_enabled(bool on) {
   if (actor_) actor_->SetVisibility(on);
+  if (label_) label_->SetVisibility(on);
 }
 
 // ---------------------------------------------------------------- target
@@ -362,6 +432,7 @@ void TargetPoseRenderer::subscribe(bus::Bus& bus) {
 }
 
 void TargetPoseRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
   auto sphere = vtkSmartPointer<vtkSphereSource>::New();
   sphere->SetRadius(0.15);
   auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();

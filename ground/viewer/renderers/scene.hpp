@@ -9,6 +9,7 @@
 #include <aerie/spherical_depth_t.hpp>
 #include <aerie/target_pose_t.hpp>
 #include <vtkActor.h>
+#include <vtkTextActor.h>
 #include <vtkSmartPointer.h>
 
 #include <Eigen/Core>
@@ -84,15 +85,18 @@ class DepthCloudRenderer : public Renderer {
   std::string channel_;
   Latest<std::vector<Eigen::Vector3f>> cloud_;
   uint64_t seen_ = 0;
-  size_t shown_ = 0;
+  size_t shown_ = 0, quads_ = 0;
   vtkSmartPointer<vtkActor> actor_;
 };
 
-// MAP_OCTOMAP: occupied voxels as cubes coloured by height (like the thesis' Fig. 4.10).
-// 'v' cycles the display resolution (OctoMap tree depth: finest, then coarser levels).
+// MAP_OCTOMAP: occupied voxels coloured by height (like the thesis' Fig. 4.10), drawn as
+// their merged visible surface. 'v' cycles the display resolution (OctoMap tree depth:
+// finest, then coarser levels). Software OpenGL draws about 2 million quads a second, so
+// a map whose surface needs more than `max_quads` quads is shown one level coarser (and
+// so on) and the pane says so; 0 = no limit.
 class OctomapRenderer : public Renderer {
  public:
-  explicit OctomapRenderer(std::string channel = "MAP_OCTOMAP");
+  explicit OctomapRenderer(std::string channel = "MAP_OCTOMAP", size_t max_quads = 40000);
   ~OctomapRenderer() override;
   void subscribe(bus::Bus& bus) override;
   void attach(Layout& layout) override;
@@ -101,23 +105,23 @@ class OctomapRenderer : public Renderer {
   // 0 = finest; n = n levels coarser (voxels 2^n times larger).
   void set_coarsening(int levels);
   int coarsening() const { return coarsening_; }
+  int coarsening_shown() const { return shown_coarsening_; }  // after the quad budget
+  void set_max_quads(size_t n);
   size_t voxels_shown() const { return shown_; }
+  size_t quads_shown() const { return quads_; }
 
  protected:
   void on_enabled(bool on) override;
 
  private:
-  struct Voxels;
   struct Map;
-  void extract();
 
   std::string channel_;
   std::unique_ptr<Map> map_;
-  uint64_t seen_ = 0;
-  int coarsening_ = 0;
-  bool dirty_ = false;
-  size_t shown_ = 0;
+  int coarsening_ = 0, shown_coarsening_ = 0;
+  size_t shown_ = 0, quads_ = 0;
   vtkSmartPointer<vtkActor> actor_;
+  vtkSmartPointer<vtkTextActor> label_;
 };
 
 // TARGET_POSE (relative to the camera) placed in the world with the newest camera pose

@@ -174,7 +174,7 @@ TEST(MapService, MatchesPosesByUtimeAndCountsBadInputs) {
   EXPECT_EQ(h.counter("frames_mapped"), 4);
   EXPECT_EQ(h.counter("depth_out_of_order"), 1);
 
-  // NaN in the pose, a negative range, an inconsistent grid: malformed, dropped.
+  // NaN in the pose, a negative range, an inconsistent grid, NaN ranges: malformed, dropped.
   auto bad = h.depth_msg(1'800'000, T, true);
   bad.position[0] = std::numeric_limits<double>::quiet_NaN();
   h.bus.publish("VO_DEPTH", bad);
@@ -184,11 +184,14 @@ TEST(MapService, MatchesPosesByUtimeAndCountsBadInputs) {
   bad = h.depth_msg(1'800'000, T, true);
   bad.polar_step_rad = std::numeric_limits<float>::quiet_NaN();
   h.bus.publish("VO_DEPTH", bad);
+  bad = h.depth_msg(1'800'000, T, true);
+  bad.range_scale_m = std::numeric_limits<float>::quiet_NaN();  // NaN ranges (r = range * scale)
+  h.bus.publish("VO_DEPTH", bad);
   aerie::pose_t bad_pose = h.pose_msg(1'800'000, T);
   bad_pose.orientation[0] = 3.0;
   h.bus.publish("VO_POSE", bad_pose);
   h.spin();
-  EXPECT_EQ(h.counter("depth_malformed"), 3);
+  EXPECT_EQ(h.counter("depth_malformed"), 4);
   EXPECT_EQ(h.counter("poses_invalid"), 1);
   EXPECT_EQ(h.counter("frames_mapped"), 4);
 }

@@ -5,11 +5,17 @@
 
 #include <chrono>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <thread>
 
 #include <aerie/control_cmd_t.hpp>
 #include <bot_procman/info2_t.hpp>
+#include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
+#include <vtkCommand.h>
+#include <vtkImageData.h>
+#include <vtkWindowToImageFilter.h>
 
 #include "common/image/image_message.hpp"
 #include "common/util/time.hpp"
@@ -65,6 +71,19 @@ struct Fixture : ::testing::Test {
     return {cvRound(d.x), viewer->layout().window->GetSize()[1] - 1 - cvRound(d.y)};
   }
   void publish_image(int64_t utime, uchar value = 90) { publish_image_on(bus, utime, value); }
+  void publish_map(octomap::OcTree& tree, int64_t utime) {
+    std::ostringstream out;
+    tree.writeBinary(out);
+    const std::string bytes = out.str();
+    aerie::octomap_t m{};
+    m.utime = utime;
+    m.resolution = tree.getResolution();
+    m.binary = true;
+    m.full = true;
+    m.data.assign(bytes.begin(), bytes.end());
+    m.length = static_cast<int32_t>(m.data.size());
+    bus.publish("MAP_OCTOMAP", m);
+  }
   static void publish_image_on(bus::Bus& b, int64_t utime, uchar value = 90) {
     b.publish("CAM_LEFT", image::to_message(cv::Mat(240, 320, CV_8UC1, cv::Scalar(value)), utime, utime));
   }
@@ -194,17 +213,7 @@ TEST_F(Fixture, OctomapVoxelsAppearWhereTheMapHasThem) {
       tree.updateNode(octomap::point3d(2.1f + 0.2f * i, -0.5f + 0.2f * j, 1.1f), true);
       ++expected;
     }
-  std::ostringstream out;
-  tree.writeBinary(out);
-  const std::string bytes = out.str();
-  aerie::octomap_t m{};
-  m.utime = 5;
-  m.resolution = 0.2;
-  m.binary = true;
-  m.full = true;
-  m.data.assign(bytes.begin(), bytes.end());
-  m.length = static_cast<int32_t>(m.data.size());
-  bus.publish("MAP_OCTOMAP", m);
+  publish_map(tree, 5);
   auto* oct = dynamic_cast<OctomapRenderer*>(viewer->find("octomap"));
   ASSERT_NE(oct, nullptr);
   ASSERT_TRUE(render_until([&] { return oct->voxels_shown() > 0; }));
@@ -222,10 +231,71 @@ TEST_F(Fixture, OctomapVoxelsAppearWhereTheMapHasThem) {
   const int spread = std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]});
   EXPECT_GT(spread, 60) << "expected a height-coloured voxel at " << p << ", got " << cv::Mat(c).t();
   // Coarser display resolution: fewer (merged) voxels.
-  oct->set_coarsening(2);
-  viewer->render_frame();
-  EXPECT_LT(oct->voxels_shown(), static_cast<size_t>(expected));
+  oct->set_coarsening(2);  // meshed in the renderer's own thread
+  ASSERT_TRUE(render_until([&] { return oct->voxels_shown() < static_cast<size_t>(expected); }));
   EXPECT_GT(oct->voxels_shown(), 0u);
+  EXPECT_EQ(oct->coarsening_shown(), 2);
+}
+
+// Panes are redrawn only when they change: a new camera image redraws the image pane
+// while the 3D scene keeps the pixels it had; moving the scene's camera redraws it.
+TEST_F(Fixture, UnchangedPanesKeepTheirPixelsAndAreNotRedrawn) {
+  make(800, 500);
+  octomap::OcTree tree(0.2);
+  for (int i = 0; i < 6; ++i) tree.updateNode(octomap::point3d(0.1f + 0.2f * i, 0.1f, 0.1f), true);
+  publish_map(tree, 1);
+  publish_image(1, 40);
+  auto* oct = dynamic_cast<OctomapRenderer*>(viewer->find("octomap"));
+  ASSERT_TRUE(render_until([&] { return oct->voxels_shown() > 0 && !viewer->image_pane().image_size().empty(); }));
+  for (int i = 0; i < 3; ++i) viewer->render_frame();
+
+  int scene_draws = 0;
+  auto count = vtkSmartPointer<vtkCallbackCommand>::New();
+  count->SetClientData(&scene_draws);
+  count->SetCallback([](vtkObject*, unsigned long, void* n, void*) { ++*static_cast<int*>(n); });
+  viewer->layout().scene->AddObserver(vtkCommand::StartEvent, count);
+  auto last_frame = [&] {  // the window as last rendered, without rendering again
+    auto grab = vtkSmartPointer<vtkWindowToImageFilter>::New();
+    grab->SetInput(viewer->layout().window);
+    grab->ShouldRerenderOff();
+    grab->ReadFrontBufferOff();
+    grab->Update();
+    int dims[3];
+    grab->GetOutput()->GetDimensions(dims);
+    cv::Mat rgb(dims[1], dims[0], CV_8UC3, grab->GetOutput()->GetScalarPointer());
+    cv::Mat flipped;
+    cv::flip(rgb, flipped, 0);  // VTK rows run bottom-up
+    return flipped;
+  };
+  auto viewport = [&](vtkRenderer* r, const cv::Mat& img) {
+    double vp[4];
+    r->GetViewport(vp);
+    const int x0 = cvRound(vp[0] * img.cols), x1 = cvRound(vp[2] * img.cols);
+    const int y0 = img.rows - cvRound(vp[3] * img.rows), y1 = img.rows - cvRound(vp[1] * img.rows);
+    return img(cv::Rect(x0, y0, x1 - x0, y1 - y0)).clone();
+  };
+  const cv::Mat before = last_frame();
+  const int frames = static_cast<int>(viewer->frames_rendered());
+  publish_image(2, 200);
+  ASSERT_TRUE(render_until([&] { return viewer->frames_rendered() > frames; }));
+  const cv::Mat after = last_frame();
+  EXPECT_EQ(scene_draws, 0);
+  cv::Mat scene_gray;
+  cv::cvtColor(viewport(viewer->layout().scene, after), scene_gray, cv::COLOR_RGB2GRAY);
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(scene_gray, &lo, &hi);
+  EXPECT_GT(hi - lo, 30) << "the kept scene shows the grid and voxels, not a cleared background";
+  EXPECT_EQ(cv::norm(viewport(viewer->layout().scene, before), viewport(viewer->layout().scene, after), cv::NORM_INF),
+            0);
+  EXPECT_GT(cv::norm(viewport(viewer->layout().image, before), viewport(viewer->layout().image, after), cv::NORM_INF),
+            100);
+
+  viewer->layout().scene->GetActiveCamera()->Azimuth(40);
+  viewer->render_frame();
+  EXPECT_EQ(scene_draws, 1);
+  EXPECT_GT(cv::norm(viewport(viewer->layout().scene, after), viewport(viewer->layout().scene, last_frame()),
+                     cv::NORM_INF),
+            0);
 }
 
 TEST_F(Fixture, ChartsDrawTheirLines) {
