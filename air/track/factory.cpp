@@ -214,11 +214,18 @@ const std::vector<std::pair<std::string, Maker>>& registry() {
       return std::make_unique<HierarchicalIpslTracker>(hierarchical_ipsl_params_from_config(c), s);
     });
 #endif
-    v.emplace_back("ct", [](const util::Config& c, uint64_t s) { return make_ct("ct", c, s, single_resolution(), 100, 0.85); });
-    v.emplace_back("amcmr-ct",
-                   [](const util::Config& c, uint64_t s) { return make_ct("amcmr-ct", c, s, multi_resolution(), 150, 0.9); });
-    v.emplace_back("mil", [](const util::Config& c, uint64_t s) { return make_mil("mil", c, s, with_colour(single_resolution())); });
-    v.emplace_back("am3", [](const util::Config& c, uint64_t s) { return make_mil("am3", c, s, with_colour(multi_resolution())); });
+    v.emplace_back("ct", [](const util::Config& c, uint64_t s) {
+      return make_ct("ct", c, s, single_resolution(), 100, 0.85);
+    });
+    v.emplace_back("amcmr-ct", [](const util::Config& c, uint64_t s) {
+      return make_ct("amcmr-ct", c, s, multi_resolution(), 150, 0.9);
+    });
+    v.emplace_back("mil", [](const util::Config& c, uint64_t s) {
+      return make_mil("mil", c, s, with_colour(single_resolution()));
+    });
+    v.emplace_back("am3", [](const util::Config& c, uint64_t s) {
+      return make_mil("am3", c, s, with_colour(multi_resolution()));
+    });
     auto reference = [&v](const std::string& name, std::function<std::pair<OpenCvTracker::Init, OpenCvTracker::Update>()> f) {
       v.emplace_back(name, [name, f](const util::Config& c, uint64_t) -> std::unique_ptr<Tracker> {
         Params(c, name).check_unknown();  // OpenCV defaults only

@@ -61,11 +61,11 @@ TEST_P(TrackerFollows, Translation) {
 TEST_P(TrackerFollows, FastMotionWithFlowPrediction) {
   const Scene scene({400, 320}, {40, 32}, 1, 3.0);  // texture coarse enough for Lucas-Kanade
   const auto m = path(20, [](Motion& m, int) { m.centre += cv::Point2d(10, 8); });
-  const auto with = follow(GetParam(), scene, m, "{flow_prediction: true, redetection: false, search_radius: 10}");
+  const auto with = follow(GetParam(), scene, m, "{flow_prediction: true, search_radius: 10}");
   EXPECT_LT(with.mean_error, 3.0);
   EXPECT_LT(with.max_error, 6.0);
   if (std::string(GetParam()) == "ct" || std::string(GetParam()) == "mil") {
-    const auto without = follow(GetParam(), scene, m, "{flow_prediction: false, redetection: false, search_radius: 10}");
+    const auto without = follow(GetParam(), scene, m, "{flow_prediction: false, search_radius: 10}");
     EXPECT_GT(without.max_error, 20.0);
   }
 }
