@@ -11,7 +11,7 @@
 namespace aerie::track {
 
 struct CtParams {
-  int features = 50;     // n: dimension of the compressed vector v (rows of R)
+  int features = 100;    // n: dimension of the compressed vector v (rows of R; Zhang et al. use 50)
   int min_rects = 2;     // non-zero entries per row of R
   int max_rects = 4;
   double learning_rate = 0.85;  // eta of eq. 3.22 (weight of the old model)

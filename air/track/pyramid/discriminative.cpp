@@ -67,6 +67,7 @@ DiscriminativeTracker::DiscriminativeTracker(std::string name, DiscriminativePar
   require(p.scale_step > 1 && p.max_scale_change > 1, "scale_step and max_scale_change must be > 1");
   require(p.min_scale > 0 && p.max_scale > p.min_scale, "need 0 < min_scale < max_scale");
   require(p.lost_frames >= 1 && p.redetect_stride >= 1, "lost_frames and redetect_stride must be >= 1");
+  require(p.redetect_radius >= 0, "redetect_radius must be >= 0");
   require(p.update_confidence >= 0 && p.update_confidence <= 1 && p.found_confidence >= 0 && p.found_confidence <= 1,
           "update_confidence and found_confidence must be in [0, 1]");
   require(p.confidence_rate > 0 && p.confidence_rate <= 1, "confidence_rate must be in (0, 1]");
@@ -89,6 +90,7 @@ void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   centre_ = {box.x + box.width / 2, box.y + box.height / 2};
   scale_ = 1;
   lost_ = false;
+  lost_count_ = 0;
   low_frames_ = 0;
   mean_prominence_ = 0;
   scored_frames_ = 0;
@@ -277,7 +279,8 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   scale_ = std::min(scale_, largest_scale());
   // Scale candidates for the classifier to choose from (the first is searched).
   std::vector<double> scales = {scale_};
-  const bool flow = params_.scale_estimation == "flow" || params_.scale_estimation == "hybrid";
+  const bool flow_scale_on = params_.scale_estimation == "flow" || params_.scale_estimation == "hybrid";
+  const bool flow = flow_scale_on || params_.flow_prediction;
   if (params_.scale_estimation == "classifier") {
     scales.push_back(scale_ / params_.scale_step);
     scales.push_back(scale_ * params_.scale_step);
@@ -286,41 +289,52 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
     const cv::Size2d size = init_size_ * scale_;
     const FlowScale f = flow_scale(previous_gray_, gray,
                                    {centre_.x - size.width / 2, centre_.y - size.height / 2, size.width, size.height});
-    if (f.ok) {
+    if (f.ok && flow_scale_on) {
       const double s = std::clamp(scale_ * std::clamp(f.ratio, 1 / params_.max_scale_change, params_.max_scale_change),
                                   params_.min_scale, largest_scale());
       if (params_.scale_estimation == "flow") scales[0] = scale_ = s; else scales.push_back(s);
     }
+    if (f.ok && params_.flow_prediction) {
+      centre_ += f.shift;
+      centre_.x = std::clamp(centre_.x, 0.0, frame_size_.width - 1.0);
+      centre_.y = std::clamp(centre_.y, 0.0, frame_size_.height - 1.0);
+    }
   }
   if (flow) gray.copyTo(previous_gray_);
-  if (!lost_) {
-    // Region that the search, the scale candidates and the training samples can reach.
-    const int top = levels() - 1;
-    const double search = top == 0 ? params_.search_radius
-                                   : std::max(params_.coarse_radius * (1 << top), params_.max_radius * (1 << (top - 1)));
-    const double reach = search + params_.neg_outer + (2 << top) + 2;
-    const cv::Size2d half = init_size_ * (scale_ * params_.scale_step / 2);
-    build_pyramid(frame, gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
-                                           static_cast<int>(centre_.y - half.height - reach)),
-                                 cv::Point(static_cast<int>(std::ceil(centre_.x + half.width + reach)),
-                                           static_cast<int>(std::ceil(centre_.y + half.height + reach)))));
-  } else {
-    build_pyramid(frame, gray, {0, 0, gray.cols, gray.rows});
+  // Region that the search, the scale candidates and the training samples can reach; while
+  // lost, the re-detection scan region (the whole frame, or redetect_radius doubled per lost frame).
+  const int top = levels() - 1;
+  const double radius = top == 0 ? params_.search_radius
+                                 : std::max(params_.coarse_radius * (1 << top), params_.max_radius * (1 << (top - 1)));
+  double reach = radius + params_.neg_outer + (2 << top) + 2;
+  if (lost_) {
+    reach = params_.redetect_radius > 0 ? reach + params_.redetect_radius * std::pow(2.0, std::min(lost_count_, 16))
+                                        : frame_size_.width + frame_size_.height;
+    ++lost_count_;
   }
-  Search s = search(lost_);
+  const cv::Size2d half = init_size_ * (scale_ * params_.scale_step / 2);
+  build_pyramid(frame, gray, cv::Rect(cv::Point(static_cast<int>(centre_.x - half.width - reach),
+                                         static_cast<int>(centre_.y - half.height - reach)),
+                               cv::Point(static_cast<int>(std::ceil(centre_.x + half.width + reach)),
+                                         static_cast<int>(std::ceil(centre_.y + half.height + reach)))));
+  // While lost, the target is still searched around its last location (an uncertain
+  // stretch is often the target itself changing) and the scan proposes a re-detection.
+  Search s = search(false);
+  Search scan;
+  scan.ok = false;
+  if (lost_) scan = search(true);
   state.levels = std::move(s.levels);
-  if (!s.ok) {
+  if (lost_) state.levels.insert(state.levels.end(), scan.levels.begin(), scan.levels.end());
+  if (!s.ok && !scan.ok) {
     state.pose = {centre_.x, centre_.y, scale_, 0.0};
     state.lost = true;
     return state;
   }
-  const cv::Point2d previous = centre_;
-  const double previous_scale = scale_;
-  centre_ = s.centre;
-  if (scales.size() > 1 && !lost_) adapt_scale(s.centre, scales);
   // Confidence: the prominence of the best sample relative to its running mean while tracking well.
-  const double z = s.prominence;
-  const double conf = scored_frames_ == 0 ? 1.0 : std::clamp(z / std::max(mean_prominence_, 1e-6), 0.0, 1.0);
+  auto confidence = [&](const Search& r) {
+    return scored_frames_ == 0 ? 1.0 : std::clamp(r.prominence / std::max(mean_prominence_, 1e-6), 0.0, 1.0);
+  };
+  double z = s.prominence, conf = s.ok ? confidence(s) : 0.0;
   auto confident_frame = [&] {
     const double rate = std::max(params_.confidence_rate, 1.0 / ++scored_frames_);
     mean_prominence_ += rate * (z - mean_prominence_);
@@ -331,6 +345,8 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   auto drift = [&] { mean_prominence_ += 0.25 * params_.confidence_rate * (z - mean_prominence_); };
 
   if (!lost_) {
+    centre_ = s.centre;
+    if (scales.size() > 1) adapt_scale(s.centre, scales);
     // Hysteresis: once below update_confidence, learning resumes only at found_confidence.
     const bool uncertain = low_frames_ > 0 ? conf < params_.found_confidence : conf < params_.update_confidence;
     low_frames_ = uncertain ? low_frames_ + 1 : 0;
@@ -338,17 +354,28 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
       confident_frame();
     } else {
       drift();
-      if (params_.redetection && low_frames_ >= params_.lost_frames) lost_ = true;
+      if (params_.redetection && low_frames_ >= params_.lost_frames) {
+        lost_ = true;
+        lost_count_ = 0;
+      }
     }
-  } else if (conf >= params_.found_confidence) {  // lost, found again
-    lost_ = false;
-    low_frames_ = 0;
-    state.redetected = true;
-    confident_frame();
   } else {
-    drift();
-    centre_ = previous;  // still lost: report where the target was last seen
-    scale_ = previous_scale;
+    // A re-detection elsewhere must score above the local search and reach found_confidence.
+    const double conf_scan = scan.ok ? confidence(scan) : 0.0;
+    const bool redetected = conf_scan >= params_.found_confidence && (!s.ok || scan.score > s.score);
+    if (redetected) {
+      z = scan.prominence;
+      conf = conf_scan;
+      state.redetected = true;
+    }
+    if (s.ok || redetected) centre_ = redetected ? scan.centre : s.centre;
+    if (redetected || conf >= params_.found_confidence) {  // found again
+      lost_ = false;
+      low_frames_ = 0;
+      confident_frame();
+    } else {
+      drift();
+    }
   }
   state.pose = {centre_.x, centre_.y, scale_, 0.0};
   state.confidence = conf;

@@ -74,15 +74,21 @@ struct DiscriminativeParams {
   double scale_step = 1.05;      // rho
   double max_scale_change = 1.1; // per frame, flow
   double min_scale = 0.2, max_scale = 5;
+  // Motion prediction: the search is centred on the previous location moved by the median
+  // flow of the points in the box (the same Lucas-Kanade points as the flow scale), so that
+  // fast motion stays inside the search radius; the classifier still decides.
+  bool flow_prediction = true;
   // Occlusion, loss and re-detection. The confidence of a frame is the prominence of its best
   // sample over the coarsest level's search (best minus median score, per term) relative to the
   // running mean of that prominence over the frames tracked with confidence.
   double update_confidence = 0.5;  // below it the classifiers are not updated (occlusion, clutter)
   double confidence_rate = 0.05;   // weight of a new frame in the running mean
-  bool redetection = true;
+  bool redetection = false;        // off by default: it lowered the mean AUC (docs/results/track.md)
   int lost_frames = 3;             // frames in a row below update_confidence -> lost
   double found_confidence = 0.7;   // a re-detection scan result at least this -> re-detected
   int redetect_stride = 8;         // grid step of the scan, full-resolution pixels
+  double redetect_radius = 0;      // > 0: scan only this far (px) around the last location, doubled
+                                   // every lost frame; 0: the whole frame
 };
 
 class DiscriminativeTracker : public Tracker {
@@ -132,6 +138,7 @@ class DiscriminativeTracker : public Tracker {
   double scale_ = 1;
   bool lost_ = false;
   int low_frames_ = 0;
+  int lost_count_ = 0;  // frames since the target was lost
   double mean_prominence_ = 0;  // running mean of Search::prominence on confident frames
   int scored_frames_ = 0;
   cv::Mat previous_gray_;

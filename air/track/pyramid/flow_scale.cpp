@@ -17,7 +17,7 @@ double median(std::vector<double> v) {
 FlowScale flow_scale(const cv::Mat& prev, const cv::Mat& next, const cv::Rect2d& box, int grid) {
   FlowScale out;
   // Work on a crop around the box: the points move by tens of pixels at most.
-  const double margin = 24 + 0.5 * std::max(box.width, box.height);
+  const double margin = 40 + 0.5 * std::max(box.width, box.height);
   const cv::Rect roi = cv::Rect(cv::Point(static_cast<int>(box.x - margin), static_cast<int>(box.y - margin)),
                                 cv::Point(static_cast<int>(box.x + box.width + margin),
                                           static_cast<int>(box.y + box.height + margin))) &
@@ -35,8 +35,8 @@ FlowScale flow_scale(const cv::Mat& prev, const cv::Mat& next, const cv::Rect2d&
   std::vector<float> err;
   const cv::Mat a = prev(roi), b = next(roi);
   const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
-  cv::calcOpticalFlowPyrLK(a, b, p0, p1, st1, err, cv::Size(9, 9), 2, term);
-  cv::calcOpticalFlowPyrLK(b, a, p1, pb, st2, err, cv::Size(9, 9), 2, term);
+  cv::calcOpticalFlowPyrLK(a, b, p0, p1, st1, err, cv::Size(9, 9), 3, term);
+  cv::calcOpticalFlowPyrLK(b, a, p1, pb, st2, err, cv::Size(9, 9), 3, term);
   std::vector<int> idx;
   std::vector<double> fb;
   for (size_t k = 0; k < p0.size(); ++k)

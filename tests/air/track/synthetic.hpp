@@ -28,8 +28,9 @@ inline cv::Mat texture(cv::Size size, uint64_t seed, double blur, int lo, int hi
 
 class Scene {
  public:
-  Scene(cv::Size frame, cv::Size target, uint64_t seed = 1)
-      : background_(texture(frame, seed, 6, 40, 200)), target_(texture(target, seed + 1, 1.5, 0, 255)) {}
+  // target_blur: scale of the target's texture (pixels; larger = coarser).
+  Scene(cv::Size frame, cv::Size target, uint64_t seed = 1, double target_blur = 1.5)
+      : background_(texture(frame, seed, 6, 40, 200)), target_(texture(target, seed + 1, target_blur, 0, 255)) {}
 
   cv::Size target_size() const { return target_.size(); }
 
