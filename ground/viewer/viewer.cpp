@@ -143,8 +143,9 @@ bool Viewer::schedule_panes(bool image_changed, const std::vector<vtkRenderer*>&
   for (auto& s : panes_) {
     const bool is_image = s.pane == layout_.image.Get();
     s.pending = s.pending || (is_image ? image_changed : std::count(changed.begin(), changed.end(), s.pane) > 0);
-    // A pane is drawn when its view moved (interaction) at once, when its content changed
-    // at most pane_fps times a second, the camera image with every new frame.
+    // Due at once when its view moved (interaction); after a content change at most
+    // pane_fps times a second and at most half of the time (twice its last cost apart);
+    // the camera image with every new frame.
     const double interval = std::max(1.0 / options_.pane_fps, 2.0 * s.cost_s);
     const bool due = redraw_all_ || options_.always_redraw || view_of(s.pane) != s.view ||
                      (s.pending && (is_image || now - s.last_drawn_s >= interval));
