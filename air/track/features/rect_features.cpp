@@ -36,39 +36,40 @@ WeightedRect random_rect(cv::Size box, Rng& rng) {
   return r;
 }
 
-}  // namespace
-
-std::vector<RectFeature> make_compressive_features(cv::Size box, int n, int min_rects, int max_rects,
-                                                   const std::vector<int>& channels, Rng& rng) {
-  check_box(box, min_rects, max_rects, "compressive features");
-  if (channels.empty()) throw std::invalid_argument("compressive features: no channels");
+// Random features of min_rects..max_rects rectangles inside the box, each on a random
+// channel; `weight` gives each rectangle its weight.
+template <typename Weight>
+std::vector<RectFeature> make_features(cv::Size box, int n, int min_rects, int max_rects,
+                                       const std::vector<int>& channels, Rng& rng, const char* what, Weight weight) {
+  check_box(box, min_rects, max_rects, what);
+  if (channels.empty()) throw std::invalid_argument(std::string(what) + ": no channels");
   std::vector<RectFeature> out(n);
   for (auto& f : out) {
     f.channel = channels[uniform_int(rng, 0, static_cast<int>(channels.size()) - 1)];
     f.count = uniform_int(rng, min_rects, max_rects);
     for (int r = 0; r < f.count; ++r) {
       f.rects[r] = random_rect(box, rng);
-      f.rects[r].weight = uniform_int(rng, 0, 1) ? 1.0f : -1.0f;  // eq. 3.19: +-sqrt(s), each with p = 1/(2s)
+      f.rects[r].weight = weight(f.rects[r]);
     }
   }
   return out;
 }
 
+}  // namespace
+
+std::vector<RectFeature> make_compressive_features(cv::Size box, int n, int min_rects, int max_rects,
+                                                   const std::vector<int>& channels, Rng& rng) {
+  // eq. 3.19: +-sqrt(s), each with p = 1/(2s)
+  return make_features(box, n, min_rects, max_rects, channels, rng, "compressive features",
+                       [&](const auto&) { return uniform_int(rng, 0, 1) ? 1.0f : -1.0f; });
+}
+
 std::vector<RectFeature> make_haar_features(cv::Size box, int n, int min_rects, int max_rects,
                                             const std::vector<int>& channels, Rng& rng) {
-  check_box(box, min_rects, max_rects, "Haar features");
-  if (channels.empty()) throw std::invalid_argument("Haar features: no channels");
-  std::vector<RectFeature> out(n);
-  for (auto& f : out) {
-    f.channel = channels[uniform_int(rng, 0, static_cast<int>(channels.size()) - 1)];
-    f.count = uniform_int(rng, min_rects, max_rects);
-    for (int r = 0; r < f.count; ++r) {
-      f.rects[r] = random_rect(box, rng);
-      const double weight = 2 * uniform01(rng) - 1;
-      f.rects[r].weight = static_cast<float>(weight / (f.rects[r].w * f.rects[r].h));  // weight x rectangle mean
-    }
-  }
-  return out;
+  return make_features(box, n, min_rects, max_rects, channels, rng, "Haar features", [&](const auto& rect) {
+    const double weight = 2 * uniform01(rng) - 1;
+    return static_cast<float>(weight / (rect.w * rect.h));  // weight x rectangle mean
+  });
 }
 
 std::vector<RectFeature> scale_features(const std::vector<RectFeature>& features, double s) {

@@ -97,16 +97,22 @@ void validate(const HierarchicalIpslParams& p) {
   validate_common(what, p.sigma, p.appearance, p.recovery);
 }
 
+// The parameters read from `c`, validated; an error names the config section.
+template <typename Params>
+Params validated(const Params& p, const util::Config& c, const char* tracker) {
+  try {
+    validate(p);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(config_name(c, tracker) + ": " + e.what());
+  }
+  return p;
+}
+
 IpslParams ipsl_params_from_config(const util::Config& c) {
   IpslParams p;
   p.particles = c.get("particles", p.particles);
   read_common(c, p.sigma, p.appearance, p.recovery);
-  try {
-    validate(p);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(config_name(c, "ipsl") + ": " + e.what());
-  }
-  return p;
+  return validated(p, c, "ipsl");
 }
 
 HierarchicalIpslParams hierarchical_ipsl_params_from_config(const util::Config& c) {
@@ -121,12 +127,7 @@ HierarchicalIpslParams hierarchical_ipsl_params_from_config(const util::Config& 
   p.coarsest_block_size = c.get("coarsest_block_size", p.coarsest_block_size);
   p.probes = c.get("probes", p.probes);
   read_common(c, p.sigma, p.appearance, p.recovery);
-  try {
-    validate(p);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(config_name(c, "ipsl-mr") + ": " + e.what());
-  }
-  return p;
+  return validated(p, c, "ipsl-mr");
 }
 
 // ---------------------------------------------------------------------------------------------
