@@ -57,6 +57,9 @@ struct OccupancyParams {
     }
   } stereo;
   double visibility_if_occluded = 0.2;  // S&Z P(visible | occluded); 1 disables the visibility term
+  // Skip free space inside 4x4x4 bricks already clamped free (a miss cannot change them).
+  // Exact: the map is the same either way; false only to check that.
+  bool skip_clamped_free = true;
 
   void validate() const;  // throws std::invalid_argument naming the key
 };

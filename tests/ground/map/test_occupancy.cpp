@@ -1,6 +1,8 @@
 // The robust occupancy update, queries, persistence and the distance map (ground/map).
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -189,6 +191,40 @@ TEST(Occupancy, ChangedRegionCoversTheFrame) {
   EXPECT_FALSE(map.take_changed_region().has_value());
   map.insert_frame({{2.05f, 0.05f, 0.05f}}, {0.05f, 0.05f, 0.05f});  // no state change
   EXPECT_FALSE(map.take_changed_region().has_value());
+}
+
+// Skipping free space in bricks already clamped free is exact: over a flight that revisits
+// the same space (so that bricks saturate), the map is identical, leaf for leaf, and the
+// shortcut did skip updates.
+TEST(Occupancy, SkippingClampedFreeBricksLeavesTheMapUnchanged) {
+  const m::test::Room room;
+  m::OccupancyParams exact, fast;
+  exact.skip_clamped_free = false;
+  m::OccupancyMap reference(exact), map(fast);
+  const aerie::spherical::SphericalEncoder encoder(kCam, kSize);
+  size_t reference_updates = 0, updates = 0;
+  for (int i = 0; i < 48; ++i) {  // six headings, eight times each
+    const auto T = m::test::camera_pose({-1.0, 0.0, 1.2}, (i % 6) * M_PI / 6);
+    const auto depth = encoder.encode_depth(m::test::render_depth(room, T, kCam, kSize));
+    const auto a = reference.insert_depth(depth, T);
+    const auto b = map.insert_depth(depth, T);
+    reference_updates += a.free_voxels;
+    updates += b.free_voxels;
+    EXPECT_EQ(a.hit_voxels, b.hit_voxels);
+    EXPECT_EQ(a.state_changes, b.state_changes);
+  }
+  EXPECT_LT(updates, reference_updates * 3 / 4) << "clamped free bricks were not skipped";
+  std::ostringstream a, b;
+  reference.tree().writeBinaryConst(a);
+  map.tree().writeBinaryConst(b);
+  EXPECT_EQ(reference.tree().size(), map.tree().size());
+  EXPECT_TRUE(a.str() == b.str()) << "the maps differ";
+  // writeBinary stores occupied/free only: the log-odds must agree too.
+  auto it = map.tree().begin_leafs();
+  for (auto ref = reference.tree().begin_leafs(); ref != reference.tree().end_leafs(); ++ref, ++it) {
+    ASSERT_EQ(ref.getKey(), it.getKey());
+    ASSERT_EQ(ref->getLogOdds(), it->getLogOdds());
+  }
 }
 
 TEST(Occupancy, SimulatedRoomIsReconstructedWithinOneVoxel) {
