@@ -27,6 +27,7 @@ class CtClassifier : public SampleClassifier {
   void score(const ChannelImages& ch, const SampleSet& samples, double scale, std::vector<float>& out) override;
   void update(const ChannelImages& ch, const SampleSet& positives, const SampleSet& negatives, double scale) override;
   int terms() const override { return static_cast<int>(features_.base().size()); }
+  std::unique_ptr<SampleClassifier> clone() const override { return std::make_unique<CtClassifier>(*this); }
 
   const NaiveBayes& bayes() const { return bayes_; }
 

@@ -28,6 +28,7 @@ class MilClassifier : public SampleClassifier {
   void score(const ChannelImages& ch, const SampleSet& samples, double scale, std::vector<float>& out) override;
   void update(const ChannelImages& ch, const SampleSet& positives, const SampleSet& negatives, double scale) override;
   int terms() const override { return static_cast<int>(boost_.selected().size()); }
+  std::unique_ptr<SampleClassifier> clone() const override { return std::make_unique<MilClassifier>(*this); }
 
   const MilBoost& boost() const { return boost_; }
 

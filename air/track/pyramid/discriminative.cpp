@@ -105,6 +105,7 @@ void DiscriminativeTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   int n = std::min(params_.max_levels, pyramid::num_levels(box.width, box.height, params_.min_size));
   while (n > 1 && std::min(box.width, box.height) / (1 << (n - 1)) < 4) --n;
   levels_.clear();
+  trusted_.clear();
   levels_.resize(n);
   for (int p = 0; p < n; ++p) {
     const double f = 1.0 / (1 << p);
@@ -339,6 +340,12 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
     const double rate = std::max(params_.confidence_rate, 1.0 / ++scored_frames_);
     mean_prominence_ += rate * (z - mean_prominence_);
     learn();
+    if (params_.redetection && conf >= params_.found_confidence) {
+      std::vector<std::unique_ptr<SampleClassifier>> models;
+      for (const auto& level : levels_) models.push_back(level.classifier->clone());
+      trusted_.push_back(std::move(models));
+      if (trusted_.size() > 2) trusted_.pop_front();
+    }
   };
   // Without confident frames the reference drifts slowly towards what is seen, so that a
   // lasting change of appearance ends the freeze (and a loss) instead of making it permanent.
@@ -357,6 +364,10 @@ TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
       if (params_.redetection && low_frames_ >= params_.lost_frames) {
         lost_ = true;
         lost_count_ = 0;
+        // Frames between update_confidence and found_confidence were still learned; the
+        // loss says they were the background: search with a trusted model.
+        if (!trusted_.empty())
+          for (size_t p = 0; p < levels_.size(); ++p) levels_[p].classifier = trusted_.front()[p]->clone();
       }
     }
   } else {

@@ -17,6 +17,7 @@
 // (low confidence for some frames freezes the classifiers and scans the whole coarsest
 // level until the target scores high again).
 #include <functional>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,6 +43,9 @@ class SampleClassifier {
   // Number of weak terms summed into a score (features of CT, selected weak classifiers of MIL);
   // score / terms is the mean log-likelihood ratio per term, comparable between classifiers.
   virtual int terms() const = 0;
+  // A copy of the learned model (restored when a loss shows that the last updates learned
+  // the background).
+  virtual std::unique_ptr<SampleClassifier> clone() const = 0;
 };
 
 // Makes the classifier of one level for a template of the given size (pixels of that level)
@@ -138,6 +142,10 @@ class DiscriminativeTracker : public Tracker {
   double scale_ = 1;
   bool lost_ = false;
   int low_frames_ = 0;
+  // With redetection: every level's classifier as of the last two frames at found_confidence
+  // (oldest first). A loss restores the older one: the frame just before an uncertain
+  // stretch may already have learned the background.
+  std::deque<std::vector<std::unique_ptr<SampleClassifier>>> trusted_;
   int lost_count_ = 0;  // frames since the target was lost
   double mean_prominence_ = 0;  // running mean of Search::prominence on confident frames
   int scored_frames_ = 0;

@@ -26,6 +26,7 @@ class PeakClassifier : public SampleClassifier {
   }
   void update(const ChannelImages&, const SampleSet&, const SampleSet&, double) override { ++updates; }
   int terms() const override { return 1; }
+  std::unique_ptr<SampleClassifier> clone() const override { return std::make_unique<PeakClassifier>(*this); }
   int updates = 0;
 
  private:
