@@ -148,6 +148,15 @@ void check_update(const cv::Mat& frame, bool initialised, const cv::Size& size, 
 
 Similarity box_centre(const cv::Rect2d& box) { return {box.x + box.width / 2, box.y + box.height / 2, 1, 0}; }
 
+// The state at init: the box itself, fully confident.
+TrackState initial_state(const cv::Rect2d& box) {
+  TrackState s;
+  s.pose = box_centre(box);
+  s.initial_size = box.size();
+  s.confidence = 1;
+  return s;
+}
+
 // Octave of the frame pyramid to sample from so that the target spans about patch_size pixels
 // (bilinear sampling of a much larger region would alias).
 int sampling_octave(const cv::Size2d& template_size, double scale, int patch_size) {
@@ -300,10 +309,7 @@ void IpslTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   validate_init(frame, box);
   frame_size_ = frame.size();
   const auto& a = params_.appearance;
-  state_ = {};
-  state_.pose = box_centre(box);
-  state_.initial_size = box.size();
-  state_.confidence = 1;
+  state_ = initial_state(box);
   build_pyramid(frame, sampling_octave(box.size(), 1, a.patch_size), pyramid_);
   model_ = std::make_unique<AppearanceModel>(a.patch_size * a.patch_size, a.max_basis, a.forgetting, a.block_size,
                                              a.likelihood, a.anchor);
@@ -365,10 +371,7 @@ void HierarchicalIpslTracker::init(const cv::Mat& frame, const cv::Rect2d& box) 
   validate_init(frame, box);
   frame_size_ = frame.size();
   const auto& a = params_.appearance;
-  state_ = {};
-  state_.pose = box_centre(box);
-  state_.initial_size = box.size();
-  state_.confidence = 1;
+  state_ = initial_state(box);
 
   // eq. 3.11, capped by max_levels.
   const int n_levels = std::min(params_.max_levels, pyramid::num_levels(box.width, box.height, params_.min_size));
