@@ -38,9 +38,10 @@ static double cpu_seconds(int who) {
 
 int main(int argc, char** argv) {
   CLI::App app{"bench_viewer: display rate and CPU of aerie-viewer with 752x480 stereo at 20 Hz + a large OctoMap"};
-  double seconds = 20;
-  int voxels = 100000;
-  std::string out, map_kind = "rough";
+  double seconds = 20, map_period = 1.0;
+  int voxels = 100000, coarsening = 0;
+  bool poses = false;
+  std::string out, map_kind = "rough", map_file, snapshot;
   viewer::ViewerOptions opts;
   app.add_option("--seconds", seconds, "measurement time")->capture_default_str();
   app.add_option("--voxels", voxels, "occupied voxels in the map")->capture_default_str();
@@ -49,16 +50,11 @@ int main(int argc, char** argv) {
                  "1-4 voxels (a face between almost every pair of columns, worst case)")
       ->check(CLI::IsMember({"floor", "rough"}))
       ->capture_default_str();
-  std::string map_file, snapshot;
-  app.add_option("--snapshot", snapshot, "write a PNG of the window at the end");
   app.add_option("--map-file", map_file, "a saved map (.bt/.ot, e.g. the demo flight's) instead of --map/--voxels")
       ->check(CLI::ExistingFile);
-  bool poses = false;
-  double map_period = 1.0;
   app.add_option("--map-period", map_period,
                  "seconds between full MAP_OCTOMAP messages (aerie-map's default publish period; 0: once)")
       ->capture_default_str();
-  int coarsening = 0;
   app.add_option("--coarsening", coarsening, "display the map this many levels coarser (the viewer's 'v' key)")
       ->capture_default_str();
   app.add_flag("--poses", poses, "also publish a VO_POSE with every stereo frame (the 3D scene changes at 20 Hz)");
@@ -67,6 +63,7 @@ int main(int argc, char** argv) {
   app.add_option("--pane-fps", opts.pane_fps, "redraw rate limit of the non-camera panes")->capture_default_str();
   app.add_option("--map-max-quads", opts.map_max_quads, "quad budget of the map display (0: none)")
       ->capture_default_str();
+  app.add_option("--snapshot", snapshot, "write a PNG of the window at the end");
   app.add_option("--out", out, "JSON result file");
   CLI11_PARSE(app, argc, argv);
 
