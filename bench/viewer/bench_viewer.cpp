@@ -25,6 +25,8 @@
 
 #include "common/image/image_message.hpp"
 #include "common/util/time.hpp"
+#include "ground/map/occupancy.hpp"
+#include "ground/map/octomap_message.hpp"
 #include "ground/viewer/renderers/scene.hpp"
 #include "ground/viewer/viewer.hpp"
 
@@ -78,17 +80,10 @@ int main(int argc, char** argv) {
   auto tree_ptr = std::make_unique<octomap::OcTree>(0.1);
   std::mt19937 rng(1);
   if (!map_file.empty()) {
-    if (map_file.size() > 3 && map_file.substr(map_file.size() - 3) == ".ot") {
-      std::unique_ptr<octomap::AbstractOcTree> saved(octomap::AbstractOcTree::read(map_file));
-      if (auto* t = dynamic_cast<octomap::OcTree*>(saved.get())) {
-        saved.release();
-        tree_ptr.reset(t);
-      }
-    } else if (!tree_ptr->readBinary(map_file)) {
-      tree_ptr.reset();
-    }
-    if (!tree_ptr) {
-      std::cerr << "bench_viewer: " << map_file << " is not an OctoMap OcTree\n";
+    try {
+      tree_ptr = map::read_octree_file(map_file);
+    } catch (const std::exception& e) {
+      std::cerr << "bench_viewer: " << e.what() << "\n";
       return 2;
     }
     map_kind = map_file;
@@ -108,15 +103,10 @@ int main(int argc, char** argv) {
   }
   octomap::OcTree& tree = *tree_ptr;
   tree.updateInnerOccupancy();
-  std::ostringstream os;
-  tree.writeBinary(os);
-  const std::string bytes = os.str();
+  tree.prune();  // as aerie-map's tree is
   aerie::octomap_t map{};
-  map.resolution = tree.getResolution();
-  map.binary = true;
   map.full = true;
-  map.data.assign(bytes.begin(), bytes.end());
-  map.length = static_cast<int32_t>(map.data.size());
+  map::encode_octree(tree, true, map);
   bus.publish("MAP_OCTOMAP", map);
 
   std::atomic<bool> run{true};

@@ -7,6 +7,7 @@
 
 #include "common/spherical/spherical_message.hpp"
 #include "common/util/time.hpp"
+#include "ground/map/octomap_message.hpp"
 
 namespace aerie::map {
 
@@ -273,14 +274,7 @@ aerie::octomap_t MapService::encode(int64_t utime, const std::optional<Region>& 
     msg.bbox_min[0] = x0, msg.bbox_min[1] = y0, msg.bbox_min[2] = z0;
     msg.bbox_max[0] = x1, msg.bbox_max[1] = y1, msg.bbox_max[2] = z1;
   }
-  std::ostringstream out;
-  if (msg.binary)
-    tree->writeBinaryConst(out);
-  else
-    tree->write(out);
-  const std::string bytes = out.str();
-  msg.data.assign(bytes.begin(), bytes.end());
-  msg.length = static_cast<int32_t>(msg.data.size());
+  encode_octree(*tree, msg.binary, msg);
   return msg;
 }
 

@@ -428,24 +428,26 @@ void OccupancyMap::save(const std::string& path) const {
   }
 }
 
-void OccupancyMap::load(const std::string& path) {
+std::unique_ptr<octomap::OcTree> read_octree_file(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error("map: no such file '" + path + "'");
   const std::string ext = extension_of(path);
-  std::unique_ptr<octomap::OcTree> loaded;
   if (ext == ".bt") {
-    loaded = std::make_unique<octomap::OcTree>(params_.resolution);
-    if (!loaded->readBinary(path)) throw std::runtime_error("map: '" + path + "' is not a readable .bt OcTree file");
-  } else if (ext == ".ot") {
-    std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(path));
-    if (!any) throw std::runtime_error("map: '" + path + "' is not a readable .ot file");
-    auto* as_octree = dynamic_cast<octomap::OcTree*>(any.get());
-    if (as_octree == nullptr)
-      throw std::runtime_error("map: '" + path + "' holds a " + any->getTreeType() + ", expected an OcTree");
-    any.release();
-    loaded.reset(as_octree);
-  } else {
-    throw std::runtime_error("map: cannot load '" + path + "': the extension must be .bt or .ot");
+    auto tree = std::make_unique<octomap::OcTree>(0.1);  // readBinary sets the file's resolution
+    if (!tree->readBinary(path)) throw std::runtime_error("map: '" + path + "' is not a readable .bt OcTree file");
+    return tree;
   }
+  if (ext != ".ot") throw std::runtime_error("map: cannot load '" + path + "': the extension must be .bt or .ot");
+  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(path));
+  if (!any) throw std::runtime_error("map: '" + path + "' is not a readable .ot file");
+  auto* as_octree = dynamic_cast<octomap::OcTree*>(any.get());
+  if (as_octree == nullptr)
+    throw std::runtime_error("map: '" + path + "' holds a " + any->getTreeType() + ", expected an OcTree");
+  any.release();
+  return std::unique_ptr<octomap::OcTree>(as_octree);
+}
+
+void OccupancyMap::load(const std::string& path) {
+  const std::unique_ptr<octomap::OcTree> loaded = read_octree_file(path);
   params_.resolution = loaded->getResolution();
   clear();  // a fresh MapTree at the file's resolution, with our sensor model
   tree_->swapContent(*loaded);

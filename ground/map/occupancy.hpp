@@ -64,6 +64,10 @@ struct OccupancyParams {
   void validate() const;  // throws std::invalid_argument naming the key
 };
 
+// A saved OctoMap OcTree, .bt (binary) or .ot (full), chosen by extension, at the file's
+// resolution. Throws std::runtime_error naming the path and what is wrong.
+std::unique_ptr<octomap::OcTree> read_octree_file(const std::string& path);
+
 enum class Occupancy : int8_t { Unknown = 0, Free = 1, Occupied = 2 };
 
 struct FrameStats {

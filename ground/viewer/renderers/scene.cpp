@@ -22,9 +22,9 @@
 #include <mutex>
 #include <optional>
 #include <thread>
-#include <sstream>
 
 #include "common/spherical/spherical_message.hpp"
+#include "ground/map/octomap_message.hpp"
 #include "ground/viewer/layout.hpp"
 #include "ground/viewer/voxel_mesh.hpp"
 
@@ -286,30 +286,12 @@ OctomapRenderer::~OctomapRenderer() {
   map_->mesher.join();
 }
 
-namespace {
-std::unique_ptr<octomap::OcTree> parse_octree(const aerie::octomap_t& m) {
-  if (m.length != static_cast<int32_t>(m.data.size()))
-    throw std::invalid_argument("octomap_t: length disagrees with the payload size");
-  if (!(m.resolution > 0)) throw std::invalid_argument("octomap_t: resolution must be positive");
-  std::istringstream in(std::string(m.data.begin(), m.data.end()));
-  if (m.binary) {
-    auto tree = std::make_unique<octomap::OcTree>(m.resolution);
-    if (!tree->readBinary(in)) throw std::invalid_argument("octomap_t: payload is not an OctoMap binary tree");
-    return tree;
-  }
-  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
-  auto* tree = dynamic_cast<octomap::OcTree*>(any.get());
-  if (!tree) throw std::invalid_argument("octomap_t: payload is not an OctoMap OcTree");
-  any.release();
-  return std::unique_ptr<octomap::OcTree>(tree);
-}
-}  // namespace
 
 void OctomapRenderer::subscribe(bus::Bus& bus) {
   bus.subscribe<aerie::octomap_t>(
       channel_,
       [this](const aerie::octomap_t& m, const bus::ReceiveInfo&) {
-        auto incoming = parse_octree(m);  // a malformed message throws here and is counted
+        auto incoming = map::decode_octree(m);  // a malformed message throws here and is counted
         {
           std::lock_guard lock(map_->m);
           map_->inbox.emplace_back(std::move(incoming), m.full);

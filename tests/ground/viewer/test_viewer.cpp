@@ -6,7 +6,6 @@
 #include <chrono>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <thread>
 
 #include <aerie/control_cmd_t.hpp>
@@ -19,6 +18,7 @@
 
 #include "common/image/image_message.hpp"
 #include "common/util/time.hpp"
+#include "ground/map/octomap_message.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -74,16 +74,11 @@ struct Fixture : ::testing::Test {
   }
   void publish_image(int64_t utime, uchar value = 90) { publish_image_on(bus, utime, value); }
   void publish_map(octomap::OcTree& tree, int64_t utime) {
-    std::ostringstream out;
-    tree.writeBinary(out);
-    const std::string bytes = out.str();
+    tree.updateInnerOccupancy();
     aerie::octomap_t m{};
     m.utime = utime;
-    m.resolution = tree.getResolution();
-    m.binary = true;
     m.full = true;
-    m.data.assign(bytes.begin(), bytes.end());
-    m.length = static_cast<int32_t>(m.data.size());
+    map::encode_octree(tree, true, m);
     bus.publish("MAP_OCTOMAP", m);
   }
   static void publish_image_on(bus::Bus& b, int64_t utime, uchar value = 90) {
