@@ -244,7 +244,7 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
   const double res = params_.resolution;
   const int half_extent = static_cast<int>(std::ceil(max_range / res)) + 4;
   f.reset(origin_key, half_extent);
-  f.saturated_free.reset(tree, log_min_, origin_key, half_extent, params_.skip_clamped_free ? size_t{1} << 24 : 0);
+  if (params_.skip_clamped_free) f.saturated_free.reset(tree, log_min_, origin_key, half_extent, size_t{1} << 24);
 
   // 1. End voxels; a point within max_range makes its end voxel a hit.
   for (const auto& pf : points) {
@@ -309,7 +309,8 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
     const Eigen::Vector3d direction = (end - origin) / length;
     traverse_keys(origin, direction, free_length, res, 0, [&](const octomap::OcTreeKey& k, double, double t_exit) {
       if (t_exit > free_length) return false;
-      if (!f.saturated_free.contains(k) && f.voxels.mark(k)) f.updates.push_back({pack_key(k), 0.f});
+      if ((!params_.skip_clamped_free || !f.saturated_free.contains(k)) && f.voxels.mark(k))
+        f.updates.push_back({pack_key(k), 0.f});
       return k != end_key;
     });
   }
