@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "air/track/ct/ct.hpp"
+#include "air/track/dcf/dcf.hpp"
 #ifdef AERIE_HAVE_IPSL
 #include "air/track/ipsl/ipsl.hpp"
 #endif
@@ -141,6 +142,39 @@ std::unique_ptr<Tracker> make_mil(const std::string& name, const util::Config& c
   return std::make_unique<DiscriminativeTracker>(name, d, mil_classifier_factory(mil), seed);
 }
 
+std::unique_ptr<Tracker> make_dcf(const util::Config& cfg) {
+  Params in(cfg, "dcf");
+  DcfParams p;
+  in.read("cell", p.cell);
+  in.read("padding", p.padding);
+  in.read("template_area", p.template_area);
+  in.read("output_sigma", p.output_sigma);
+  in.read("lambda", p.lambda);
+  in.read("learning_rate", p.learning_rate);
+  in.read("spatial_mask", p.spatial_mask);
+  in.read("mask_scale", p.mask_scale);
+  in.read("admm_iterations", p.admm_iterations);
+  in.read("admm_mu", p.admm_mu);
+  in.read("admm_beta", p.admm_beta);
+  in.read("admm_mu_max", p.admm_mu_max);
+  in.read("hist_weight", p.hist_weight);
+  in.read("hist_bins", p.hist_bins);
+  in.read("hist_learning_rate", p.hist_learning_rate);
+  in.read("inner_padding", p.inner_padding);
+  in.read("scales", p.scales);
+  in.read("scale_step", p.scale_step);
+  in.read("scale_sigma", p.scale_sigma);
+  in.read("scale_lambda", p.scale_lambda);
+  in.read("scale_learning_rate", p.scale_learning_rate);
+  in.read("scale_model_area", p.scale_model_area);
+  in.read("min_scale", p.min_scale);
+  in.read("max_scale", p.max_scale);
+  in.read("update_confidence", p.update_confidence);
+  in.read("confidence_rate", p.confidence_rate);
+  in.check_unknown();
+  return std::make_unique<DcfTracker>(p);
+}
+
 // OpenCV's trackers behind the Aerie interface. On a failed update the box stays where it
 // was and the state says lost (OTB protocol: a box for every frame).
 class OpenCvTracker : public Tracker {
@@ -161,7 +195,7 @@ class OpenCvTracker : public Tracker {
   }
   TrackState update(const cv::Mat& frame) override {
     if (!update_) throw std::invalid_argument(name_ + ": update() before init()");
-    if (frame.empty() || frame.size() != size_) throw std::invalid_argument(name_ + ": empty frame or frame size changed");
+    validate_update(name_, frame, size_);
     cv::Rect2d b = box_;
     const bool ok = update_(frame, b);
     TrackState s;
@@ -226,6 +260,7 @@ const std::vector<std::pair<std::string, Maker>>& registry() {
     v.emplace_back("am3", [](const util::Config& c, uint64_t s) {
       return make_mil("am3", c, s, with_colour(multi_resolution()));
     });
+    v.emplace_back("dcf", [](const util::Config& c, uint64_t) { return make_dcf(c); });
     auto reference = [&v](const std::string& name, std::function<std::pair<OpenCvTracker::Init, OpenCvTracker::Update>()> f) {
       v.emplace_back(name, [name, f](const util::Config& c, uint64_t) -> std::unique_ptr<Tracker> {
         Params(c, name).check_unknown();  // OpenCV defaults only

@@ -43,6 +43,16 @@ void validate_init(const cv::Mat& frame, const cv::Rect2d& box) {
                                 std::to_string(frame.rows) + " image");
 }
 
+void validate_update(const std::string& tracker, const cv::Mat& frame, cv::Size init_size) {
+  if (frame.empty()) throw std::invalid_argument(tracker + ": empty frame");
+  if (frame.size() != init_size)
+    throw std::invalid_argument(tracker + ": frame is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
+                                ", the tracker was initialised on " + std::to_string(init_size.width) + "x" +
+                                std::to_string(init_size.height));
+  if (frame.depth() != CV_8U || (frame.channels() != 1 && frame.channels() != 3))
+    throw std::invalid_argument(tracker + ": frame must be 8-bit gray or BGR");
+}
+
 cv::Mat to_gray(const cv::Mat& frame) {
   if (frame.channels() == 1) return frame;
   cv::Mat g;

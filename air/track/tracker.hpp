@@ -56,6 +56,9 @@ class Tracker {
 
 // The checks every init() starts with; throws std::invalid_argument naming the problem.
 void validate_init(const cv::Mat& frame, const cv::Rect2d& box);
+// The checks every update() starts with: a non-empty 8-bit gray or BGR frame of the size seen
+// at init; throws std::invalid_argument starting with the tracker's name.
+void validate_update(const std::string& tracker, const cv::Mat& frame, cv::Size init_size);
 // 8-bit single-channel view or conversion of an 8-bit gray/BGR frame.
 cv::Mat to_gray(const cv::Mat& frame);
 

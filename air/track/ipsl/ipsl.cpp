@@ -137,13 +137,7 @@ namespace {
 
 void check_update(const cv::Mat& frame, bool initialised, const cv::Size& size, const std::string& name) {
   if (!initialised) throw std::invalid_argument(name + " update: called before init");
-  if (frame.empty()) throw std::invalid_argument(name + " update: empty frame");
-  if (frame.depth() != CV_8U || (frame.channels() != 1 && frame.channels() != 3))
-    throw std::invalid_argument(name + " update: frame must be 8-bit gray or BGR");
-  if (frame.size() != size)
-    throw std::invalid_argument(name + " update: frame is " + std::to_string(frame.cols) + "x" +
-                                std::to_string(frame.rows) + ", the tracker was initialised on " +
-                                std::to_string(size.width) + "x" + std::to_string(size.height));
+  validate_update(name, frame, size);
 }
 
 Similarity box_centre(const cv::Rect2d& box) { return {box.x + box.width / 2, box.y + box.height / 2, 1, 0}; }

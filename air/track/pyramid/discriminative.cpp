@@ -266,13 +266,7 @@ void DiscriminativeTracker::learn() {
 
 TrackState DiscriminativeTracker::update(const cv::Mat& frame) {
   if (levels_.empty()) throw std::invalid_argument(name_ + ": update() before init()");
-  if (frame.empty()) throw std::invalid_argument(name_ + ": empty frame");
-  if (frame.size() != frame_size_)
-    throw std::invalid_argument(name_ + ": frame is " + std::to_string(frame.cols) + "x" + std::to_string(frame.rows) +
-                                ", the tracker was initialised on " + std::to_string(frame_size_.width) + "x" +
-                                std::to_string(frame_size_.height));
-  if (frame.depth() != CV_8U || (frame.channels() != 1 && frame.channels() != 3))
-    throw std::invalid_argument(name_ + ": frame must be 8-bit gray or BGR");
+  validate_update(name_, frame, frame_size_);
   const cv::Mat gray = to_gray(frame);
 
   TrackState state;

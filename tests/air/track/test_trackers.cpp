@@ -1,5 +1,6 @@
-// CT, AMCMR-CT, MIL and AM3 follow synthetic sequences with known motion; bad input is
-// rejected with a clear error; the same seed gives the same track.
+// Aerie's trackers (CT, AMCMR-CT, MIL, AM3, DCF) follow synthetic sequences with known motion;
+// bad input is rejected with a clear error; the same seed gives the same track. The options of
+// the discriminative framework (flow prediction, re-detection) are tested on its four trackers.
 #include <gtest/gtest.h>
 
 #include "air/track/factory.hpp"
@@ -11,7 +12,8 @@ using aerie::track::test::Scene;
 
 namespace {
 
-const char* kTrackers[] = {"ct", "amcmr-ct", "mil", "am3"};
+const char* kTrackers[] = {"ct", "amcmr-ct", "mil", "am3", "dcf"};
+const char* kFramework[] = {"ct", "amcmr-ct", "mil", "am3"};  // air/track/pyramid/discriminative.hpp
 
 struct Result {
   double mean_error = 0, max_error = 0, final_scale = 1;
@@ -43,6 +45,7 @@ std::vector<Motion> path(int frames, const std::function<void(Motion&, int)>& st
 }
 
 class TrackerFollows : public ::testing::TestWithParam<const char*> {};
+class FrameworkOption : public ::testing::TestWithParam<const char*> {};
 
 }  // namespace
 
@@ -58,7 +61,7 @@ TEST_P(TrackerFollows, Translation) {
 // 10 px right and 8 down per frame (12.8 px, beyond a single-resolution search radius of
 // 10): with the flow prediction every tracker keeps up; without it CT and MIL fall behind by
 // at least 2.8 px per frame (their search cannot reach further than 10 px).
-TEST_P(TrackerFollows, FastMotionWithFlowPrediction) {
+TEST_P(FrameworkOption, FastMotionWithFlowPrediction) {
   const Scene scene({400, 320}, {40, 32}, 1, 3.0);  // texture coarse enough for Lucas-Kanade
   const auto m = path(20, [](Motion& m, int) { m.centre += cv::Point2d(10, 8); });
   const auto with = follow(GetParam(), scene, m, "{flow_prediction: true, search_radius: 10}");
@@ -74,7 +77,7 @@ TEST_P(TrackerFollows, FastMotionWithFlowPrediction) {
 // the tracker declares it lost, scans the frame and finds it again; without, it stays behind.
 // (The frame of the jump is learned before the loss shows; the trusted model restored at the
 // loss is what lets the scan's confidence reach found_confidence.)
-TEST_P(TrackerFollows, RedetectionAfterAJump) {
+TEST_P(FrameworkOption, RedetectionAfterAJump) {
   const Scene scene({320, 240}, {40, 32});
   const auto m = path(30, [](Motion& m, int i) {
     m.centre += cv::Point2d(1, 0.5);
@@ -104,7 +107,8 @@ TEST_P(TrackerFollows, Rotation) {
                           m.centre += cv::Point2d(1.5, 1);
                         }));
   EXPECT_LT(r.mean_error, 4.0);
-  EXPECT_LT(r.max_error, 8.0);
+  // DCF's box does not rotate (translation and scale filters only): its centre wanders more.
+  EXPECT_LT(r.max_error, std::string(GetParam()) == "dcf" ? 10.0 : 8.0);
 }
 
 // The target grows by 1 % per frame (to 1.35) while moving; the scale is estimated.
@@ -169,12 +173,13 @@ TEST_P(TrackerFollows, BadInputIsRejectedWithAClearError) {
   EXPECT_NO_THROW(t->update(frame));
 }
 
-INSTANTIATE_TEST_SUITE_P(Aerie, TrackerFollows, ::testing::ValuesIn(kTrackers),
-                         [](const auto& info) {
-                           std::string n = info.param;
-                           std::replace(n.begin(), n.end(), '-', '_');
-                           return n;
-                         });
+std::string test_name(const ::testing::TestParamInfo<const char*>& info) {
+  std::string n = info.param;
+  std::replace(n.begin(), n.end(), '-', '_');
+  return n;
+}
+INSTANTIATE_TEST_SUITE_P(Aerie, TrackerFollows, ::testing::ValuesIn(kTrackers), test_name);
+INSTANTIATE_TEST_SUITE_P(Aerie, FrameworkOption, ::testing::ValuesIn(kFramework), test_name);
 
 TEST(Factory, NamesUnknownTrackersAndParameters) {
   EXPECT_THROW(make_tracker("kcf"), std::invalid_argument);

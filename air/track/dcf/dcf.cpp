@@ -1,0 +1,437 @@
+#include "air/track/dcf/dcf.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "air/track/dcf/fhog.hpp"
+
+namespace aerie::track {
+namespace {
+
+using Complex = std::complex<float>;
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("dcf: " + what);
+}
+
+// The window of `size` image pixels centred on `centre`, replicated beyond the image border,
+// resized to `out`.
+cv::Mat subwindow(const cv::Mat& image, cv::Point2d centre, cv::Size2d size, cv::Size out) {
+  const cv::Rect r(cvFloor(centre.x - size.width / 2), cvFloor(centre.y - size.height / 2),
+                   std::max(1, cvRound(size.width)), std::max(1, cvRound(size.height)));
+  const cv::Rect inside = r & cv::Rect(0, 0, image.cols, image.rows);
+  cv::Mat patch;
+  if (inside == r) {
+    patch = image(r);
+  } else if (inside.empty()) {  // wholly outside: the nearest border pixel everywhere
+    const cv::Point p(std::clamp(r.x, 0, image.cols - 1), std::clamp(r.y, 0, image.rows - 1));
+    patch = cv::Mat(r.size(), image.type(), cv::Scalar::all(0));
+    patch.setTo(image.channels() == 1 ? cv::Scalar(image.at<uchar>(p)) : cv::Scalar(image.at<cv::Vec3b>(p)));
+  } else {
+    cv::copyMakeBorder(image(inside), patch, inside.y - r.y, r.br().y - inside.br().y, inside.x - r.x,
+                       r.br().x - inside.br().x, cv::BORDER_REPLICATE);
+  }
+  cv::Mat resized;
+  cv::resize(patch, resized, out, 0, 0, out.area() < patch.size().area() ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return resized;
+}
+
+// Symmetric Hann window of n samples.
+std::vector<float> hann(int n) {
+  std::vector<float> w(n, 1.f);
+  if (n > 1)
+    for (int i = 0; i < n; ++i) w[i] = 0.5f * (1 - std::cos(2 * CV_PI * i / (n - 1)));
+  return w;
+}
+
+Complex* cptr(cv::Mat& m) { return m.ptr<Complex>(); }
+const Complex* cptr(const cv::Mat& m) { return m.ptr<Complex>(); }
+
+// Signed circular offset of index i on a grid of n.
+int circular(int i, int n) { return i > n / 2 ? i - n : i; }
+
+// Parabolic sub-cell refinement of a peak from its two circular neighbours.
+double refine(float left, float centre, float right) {
+  const double d = left - 2.0 * centre + right;
+  return std::abs(d) < 1e-12 ? 0.0 : std::clamp(0.5 * (left - right) / d, -0.5, 0.5);
+}
+
+// Running average of a model: the sample itself at the first frame (or rate 1).
+void blend(cv::Mat& model, const cv::Mat& sample, double rate) {
+  if (model.empty() || rate >= 1)
+    model = sample;
+  else
+    model = (1 - rate) * model + rate * sample;
+}
+void blend(std::vector<cv::Mat>& model, const std::vector<cv::Mat>& sample, double rate) {
+  model.resize(sample.size());
+  for (size_t c = 0; c < sample.size(); ++c) blend(model[c], sample[c], rate);
+}
+
+// Index of the colour histogram bin of each pixel.
+cv::Mat bin_index(const cv::Mat& patch, int bins) {
+  const int shift = static_cast<int>(std::round(std::log2(256.0 / bins)));
+  cv::Mat idx(patch.size(), CV_32S);
+  for (int y = 0; y < patch.rows; ++y) {
+    int* o = idx.ptr<int>(y);
+    if (patch.channels() == 1) {
+      const uchar* p = patch.ptr<uchar>(y);
+      for (int x = 0; x < patch.cols; ++x) o[x] = p[x] >> shift;
+    } else {
+      const cv::Vec3b* p = patch.ptr<cv::Vec3b>(y);
+      for (int x = 0; x < patch.cols; ++x)
+        o[x] = ((p[x][2] >> shift) * bins + (p[x][1] >> shift)) * bins + (p[x][0] >> shift);
+    }
+  }
+  return idx;
+}
+
+}  // namespace
+
+void DcfParams::validate() const {
+  require(cell >= 1, "cell must be >= 1");
+  require(padding >= 0 && std::isfinite(padding), "padding must be >= 0");
+  require(template_area >= 16.0 * cell * cell, "template_area must hold at least 4x4 cells");
+  require(output_sigma > 0 && lambda > 0 && scale_lambda > 0 && scale_sigma > 0, "sigmas and lambdas must be > 0");
+  for (double r : {learning_rate, hist_learning_rate, scale_learning_rate, confidence_rate})
+    require(r > 0 && r <= 1, "learning rates must be in (0, 1]");
+  require(hist_weight >= 0 && hist_weight <= 1, "hist_weight must be in [0, 1]");
+  require(hist_bins >= 2 && hist_bins <= 256 && (hist_bins & (hist_bins - 1)) == 0,
+          "hist_bins must be a power of two in [2, 256]");
+  require(inner_padding >= 0 && inner_padding < 1, "inner_padding must be in [0, 1)");
+  require(scales >= 1 && scale_step > 1 && scale_model_area >= 4.0 * cell * cell * 4, "bad scale filter settings");
+  require(min_scale > 0 && max_scale >= min_scale, "need 0 < min_scale <= max_scale");
+  require(update_confidence >= 0 && update_confidence <= 1, "update_confidence must be in [0, 1]");
+  require(mask_scale > 0, "mask_scale must be > 0");
+  require(admm_iterations >= 0 && admm_mu > 0 && admm_beta >= 1 && admm_mu_max >= admm_mu, "bad ADMM settings");
+}
+
+cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask, const DcfParams& p) {
+  const size_t n = xf.total();
+  const float lambda = static_cast<float>(p.lambda);
+  cv::Mat yx(xf.size(), CV_32FC2), sxx(xf.size(), CV_32F);
+  const Complex* x = cptr(xf);
+  const Complex* y = cptr(yf);
+  for (size_t k = 0; k < n; ++k) {
+    cptr(yx)[k] = y[k] * std::conj(x[k]);
+    sxx.ptr<float>()[k] = std::norm(x[k]);
+  }
+  auto project = [&](const cv::Mat& spectrum, float divisor) {  // m . IDFT(.) / divisor, back to DFT
+    cv::Mat g, gf;
+    cv::dft(spectrum, g, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+    cv::dft(g.mul(mask) / divisor, gf, cv::DFT_COMPLEX_OUTPUT);
+    return gf;
+  };
+  cv::Mat g(xf.size(), CV_32FC2), l(xf.size(), CV_32FC2, cv::Scalar::all(0));
+  for (size_t k = 0; k < n; ++k) cptr(g)[k] = cptr(yx)[k] / (sxx.ptr<float>()[k] + lambda);
+  cv::Mat gm = project(g, 1.f);
+  float mu = static_cast<float>(p.admm_mu);
+  const float d = static_cast<float>(n);
+  for (int it = 0; it < p.admm_iterations; ++it) {
+    for (size_t k = 0; k < n; ++k)
+      cptr(g)[k] = (cptr(yx)[k] + mu * cptr(gm)[k] - cptr(l)[k]) / (sxx.ptr<float>()[k] + mu);
+    gm = project(l + mu * g, lambda / (2 * d) + mu);
+    l += mu * (g - gm);
+    mu = std::min(mu * static_cast<float>(p.admm_beta), static_cast<float>(p.admm_mu_max));
+  }
+  return gm;
+}
+
+DcfTracker::DcfTracker(DcfParams params, std::string name) : p_(params), name_(std::move(name)) { p_.validate(); }
+
+DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& frame, cv::Point2d centre, double scale) const {
+  const cv::Mat patch = subwindow(frame, centre, window_ * scale, model_);
+  std::vector<cv::Mat> channels = fhog(patch, p_.cell);
+  cv::Mat gray;  // mean grey level per cell, centred
+  cv::resize(to_gray(patch), gray, hann_.size(), 0, 0, cv::INTER_AREA);
+  gray.convertTo(gray, CV_32F, 1.0 / 255, -0.5);
+  channels.push_back(gray);
+  Spectrum xf(channels.size());
+  for (size_t c = 0; c < channels.size(); ++c) cv::dft(channels[c].mul(hann_), xf[c], cv::DFT_COMPLEX_OUTPUT);
+  return xf;
+}
+
+cv::Mat DcfTracker::scale_features(const cv::Mat& frame, cv::Point2d centre, double scale) const {
+  cv::Mat xs;  // feature dimension x scales
+  for (int i = 0; i < p_.scales; ++i) {
+    const cv::Mat patch = subwindow(frame, centre, target_ * (scale * scale_factors_[i]), scale_model_);
+    const std::vector<cv::Mat> h = fhog(patch, p_.cell);
+    const int cells = static_cast<int>(h[0].total());
+    if (xs.empty()) xs.create(cells * static_cast<int>(h.size()), p_.scales, CV_32F);
+    const float w = scale_hann_.at<float>(i);
+    for (size_t c = 0; c < h.size(); ++c) {
+      const float* src = h[c].ptr<float>();
+      for (int k = 0; k < cells; ++k) xs.at<float>(static_cast<int>(c) * cells + k, i) = w * src[k];
+    }
+  }
+  cv::Mat xsf;
+  cv::dft(xs, xsf, cv::DFT_ROWS | cv::DFT_COMPLEX_OUTPUT);
+  return xsf;
+}
+
+// Staple's per-pixel likelihood P(foreground | colour) = H_fg / (H_fg + H_bg).
+cv::Mat DcfTracker::colour_likelihood(const cv::Mat& patch) const {
+  const cv::Mat idx = bin_index(patch, p_.hist_bins);
+  cv::Mat out(patch.size(), CV_32F);
+  const float* fg = fg_hist_.ptr<float>();
+  const float* bg = bg_hist_.ptr<float>();
+  for (int y = 0; y < patch.rows; ++y) {
+    const int* i = idx.ptr<int>(y);
+    float* o = out.ptr<float>(y);
+    for (int x = 0; x < patch.cols; ++x) {
+      const float f = fg[i[x]], b = bg[i[x]];
+      o[x] = f + b > 0 ? f / (f + b) : 0.f;
+    }
+  }
+  return out;
+}
+
+void DcfTracker::learn_colour(const cv::Mat& frame, double rate) {
+  const cv::Mat patch = subwindow(frame, pos_, window_ * scale_, model_);
+  const cv::Mat idx = bin_index(patch, p_.hist_bins);
+  const double r = model_.width / window_.width;  // model pixels per image pixel at scale 1
+  const cv::Size2d target = target_ * r;
+  const double shrink = p_.inner_padding * (target.width + target.height) / 2;
+  const cv::Point2d c(model_.width / 2.0, model_.height / 2.0);
+  auto rect = [&](cv::Size2d s) {
+    return cv::Rect(cvRound(c.x - s.width / 2), cvRound(c.y - s.height / 2), std::max(1, cvRound(s.width)),
+                    std::max(1, cvRound(s.height))) &
+           cv::Rect(0, 0, model_.width, model_.height);
+  };
+  const cv::Rect fg_rect = rect({std::max(1.0, target.width - shrink), std::max(1.0, target.height - shrink)});
+  const cv::Rect target_rect = rect(target);
+  const int n = patch.channels() == 1 ? p_.hist_bins : p_.hist_bins * p_.hist_bins * p_.hist_bins;
+  cv::Mat fg = cv::Mat::zeros(1, n, CV_32F), bg = cv::Mat::zeros(1, n, CV_32F);
+  float nf = 0, nb = 0;
+  for (int y = 0; y < patch.rows; ++y) {
+    const int* i = idx.ptr<int>(y);
+    for (int x = 0; x < patch.cols; ++x) {
+      if (fg_rect.contains({x, y})) {
+        fg.at<float>(i[x]) += 1;
+        ++nf;
+      } else if (!target_rect.contains({x, y})) {
+        bg.at<float>(i[x]) += 1;
+        ++nb;
+      }
+    }
+  }
+  if (nf > 0) fg /= nf;
+  if (nb > 0) bg /= nb;
+  blend(fg_hist_, fg, rate);
+  blend(bg_hist_, bg, rate);
+}
+
+void DcfTracker::learn_translation(const Spectrum& xf, double rate) {
+  if (p_.spatial_mask) {
+    Spectrum g(xf.size());
+    for (size_t c = 0; c < xf.size(); ++c) g[c] = masked_filter(xf[c], yf_, mask_, p_);
+    blend(filter_, g, rate);
+    return;
+  }
+  // Running numerator conj(Y) X_c and denominator sum_c |X_c|^2 (Danelljan et al. 2014, eq. 5).
+  cv::Mat den = cv::Mat::zeros(xf[0].size(), CV_32F);
+  Spectrum num(xf.size());
+  const Complex* y = cptr(yf_);
+  for (size_t c = 0; c < xf.size(); ++c) {
+    num[c].create(xf[c].size(), CV_32FC2);
+    const Complex* x = cptr(xf[c]);
+    Complex* n = cptr(num[c]);
+    float* d = den.ptr<float>();
+    for (size_t k = 0; k < xf[c].total(); ++k) {
+      n[k] = std::conj(y[k]) * x[k];
+      d[k] += std::norm(x[k]);
+    }
+  }
+  blend(num_, num, rate);
+  blend(den_, den, rate);
+}
+
+void DcfTracker::learn_scale(const cv::Mat& xsf, double rate) {
+  cv::Mat num(xsf.size(), CV_32FC2), den = cv::Mat::zeros(1, xsf.cols, CV_32F);
+  const Complex* y = cptr(ysf_);
+  for (int r = 0; r < xsf.rows; ++r) {
+    const Complex* x = xsf.ptr<Complex>(r);
+    Complex* n = num.ptr<Complex>(r);
+    float* d = den.ptr<float>();
+    for (int k = 0; k < xsf.cols; ++k) {
+      n[k] = std::conj(y[k]) * x[k];
+      d[k] += std::norm(x[k]);
+    }
+  }
+  blend(snum_, num, rate);
+  blend(sden_, den, rate);
+}
+
+void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
+  validate_init(frame, box);
+  frame_size_ = frame.size();
+  pos_ = {box.x + box.width / 2, box.y + box.height / 2};
+  target_ = box.size();
+  scale_ = 1;
+  mean_peak_ = 0;
+  frames_ = 0;
+
+  // Translation window: target + padding * mean side, resized to about template_area pixels,
+  // a whole number of cells of FFT-friendly count.
+  const double pad = p_.padding * (target_.width + target_.height) / 2;
+  const cv::Size2d window(target_.width + pad, target_.height + pad);
+  const double r = std::sqrt(p_.template_area / window.area());
+  const cv::Size cells(cv::getOptimalDFTSize(std::max(4, cvRound(window.width * r / p_.cell))),
+                       cv::getOptimalDFTSize(std::max(4, cvRound(window.height * r / p_.cell))));
+  model_ = cells * p_.cell;
+  window_ = {model_.width / r, model_.height / r};
+  cv::createHanningWindow(hann_, cells, CV_32F);
+  // Spatial support of the constrained filter: the target box x mask_scale (rounded up to
+  // cells), centred.
+  mask_ = cv::Mat::zeros(cells, CV_32F);
+  const double support_px = p_.mask_scale * r / p_.cell;
+  const cv::Size support(std::min(cells.width, static_cast<int>(std::ceil(target_.width * support_px))),
+                         std::min(cells.height, static_cast<int>(std::ceil(target_.height * support_px))));
+  mask_(cv::Rect((cells.width - support.width) / 2, (cells.height - support.height) / 2, support.width, support.height)).setTo(1);
+
+  // Gaussian label centred on shift (0, 0), circularly.
+  const double sigma = std::sqrt(target_.area()) * r / p_.cell * p_.output_sigma;
+  cv::Mat y(cells, CV_32F);
+  for (int i = 0; i < cells.height; ++i)
+    for (int j = 0; j < cells.width; ++j) {
+      const double di = circular(i, cells.height), dj = circular(j, cells.width);
+      y.at<float>(i, j) = static_cast<float>(std::exp(-0.5 * (di * di + dj * dj) / (sigma * sigma)));
+    }
+  cv::dft(y, yf_, cv::DFT_COMPLEX_OUTPUT);
+
+  // Scale filter (DSST): S samples at step^(S/2 - i) of the current size, each resized to
+  // scale_model_area pixels of the target's aspect ratio.
+  scale_factors_.resize(p_.scales);
+  for (int i = 0; i < p_.scales; ++i) scale_factors_[i] = std::pow(p_.scale_step, p_.scales / 2 - i);
+  const double rs = std::sqrt(p_.scale_model_area / target_.area());
+  scale_model_ = {std::max(2 * p_.cell, cvRound(target_.width * rs)), std::max(2 * p_.cell, cvRound(target_.height * rs))};
+  const std::vector<float> w = hann(p_.scales);
+  scale_hann_ = cv::Mat(w, true).reshape(1, 1);
+  const double ssigma = p_.scale_sigma * std::sqrt(static_cast<double>(p_.scales));
+  cv::Mat ys(1, p_.scales, CV_32F);
+  for (int i = 0; i < p_.scales; ++i) {
+    const double d = i - p_.scales / 2;
+    ys.at<float>(i) = static_cast<float>(std::exp(-0.5 * d * d / (ssigma * ssigma)));
+  }
+  cv::dft(ys, ysf_, cv::DFT_ROWS | cv::DFT_COMPLEX_OUTPUT);
+
+  learn_translation(translation_features(frame, pos_, scale_), 1.0);
+  learn_scale(scale_features(frame, pos_, scale_), 1.0);
+  if (p_.hist_weight > 0) learn_colour(frame, 1.0);
+  initialised_ = true;
+}
+
+// Scale: the best of the S scale samples at the current location (DSST).
+double DcfTracker::best_scale_change(const cv::Mat& frame) const {
+  const cv::Mat zsf = scale_features(frame, pos_, scale_);
+  cv::Mat srf(1, p_.scales, CV_32FC2, cv::Scalar::all(0));
+  Complex* so = cptr(srf);
+  for (int r = 0; r < zsf.rows; ++r) {
+    const Complex* z = zsf.ptr<Complex>(r);
+    const Complex* a = snum_.ptr<Complex>(r);
+    for (int k = 0; k < p_.scales; ++k) so[k] += std::conj(a[k]) * z[k];
+  }
+  for (int k = 0; k < p_.scales; ++k) so[k] /= sden_.at<float>(k) + static_cast<float>(p_.scale_lambda);
+  cv::Mat sresponse;
+  cv::dft(srf, sresponse, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE | cv::DFT_ROWS);
+  cv::Point best;
+  cv::minMaxLoc(sresponse, nullptr, nullptr, nullptr, &best);
+  return scale_factors_[best.x];
+}
+
+TrackState DcfTracker::update(const cv::Mat& frame) {
+  if (!initialised_) throw std::invalid_argument(name_ + ": update() before init()");
+  validate_update(name_, frame, frame_size_);
+
+  // Translation response: IDFT(sum_c G_c Z_c) (spatial_mask) or IDFT(sum_c conj(A_c) Z_c / (B + lambda)).
+  const Spectrum zf = translation_features(frame, pos_, scale_);
+  cv::Mat rf(zf[0].size(), CV_32FC2, cv::Scalar::all(0));
+  Complex* out = cptr(rf);
+  if (p_.spatial_mask) {  // sum_c G_c Z_c
+    for (size_t c = 0; c < zf.size(); ++c) {
+      const Complex* z = cptr(zf[c]);
+      const Complex* g = cptr(filter_[c]);
+      for (size_t k = 0; k < rf.total(); ++k) out[k] += g[k] * z[k];
+    }
+  } else {
+    for (size_t c = 0; c < zf.size(); ++c) {
+      const Complex* z = cptr(zf[c]);
+      const Complex* a = cptr(num_[c]);
+      for (size_t k = 0; k < rf.total(); ++k) out[k] += std::conj(a[k]) * z[k];
+    }
+    const float* b = den_.ptr<float>();
+    for (size_t k = 0; k < rf.total(); ++k) out[k] /= b[k] + static_cast<float>(p_.lambda);
+  }
+  cv::Mat response;
+  cv::dft(rf, response, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+  const cv::Size cells = response.size();
+
+  // Reliability of the filter alone: its peak and the average peak-to-correlation energy
+  // (APCE, Wang et al. 2017) = (max - min)^2 / mean((F - min)^2).
+  double cf_peak, cf_min;
+  cv::minMaxLoc(response, &cf_min, &cf_peak);
+  const double apce = (cf_peak - cf_min) * (cf_peak - cf_min) /
+                      std::max(1e-12, cv::mean((response - cf_min).mul(response - cf_min))[0]);
+
+  // Confidence (LMCF's criterion): the filter's peak and APCE relative to their running means;
+  // below update_confidence (occlusion, loss) nothing is learned.
+  ++frames_;
+  if (frames_ == 1) {
+    mean_peak_ = cf_peak;
+    mean_apce_ = apce;
+  }
+  const double confidence = std::clamp(std::min(cf_peak / mean_peak_, apce / mean_apce_), 0.0, 1.0);
+  mean_peak_ += p_.confidence_rate * (cf_peak - mean_peak_);
+  mean_apce_ += p_.confidence_rate * (apce - mean_apce_);
+  const bool learn = confidence >= p_.update_confidence;
+
+  // Staple: merge with the mean colour likelihood of a target-sized box at each shift.
+  if (p_.hist_weight > 0) {
+    const cv::Mat patch = subwindow(frame, pos_, window_ * scale_, model_);
+    cv::Mat box;
+    const double r = model_.width / window_.width;
+    cv::boxFilter(colour_likelihood(patch), box, CV_32F,
+                  cv::Size(std::max(1, cvRound(target_.width * r)), std::max(1, cvRound(target_.height * r))),
+                  cv::Point(-1, -1), true, cv::BORDER_CONSTANT);
+    const float w = static_cast<float>(p_.hist_weight);
+    for (int i = 0; i < cells.height; ++i)
+      for (int j = 0; j < cells.width; ++j) {
+        const int py = std::clamp(model_.height / 2 + circular(i, cells.height) * p_.cell, 0, model_.height - 1);
+        const int px = std::clamp(model_.width / 2 + circular(j, cells.width) * p_.cell, 0, model_.width - 1);
+        float& v = response.at<float>(i, j);
+        v = (1 - w) * v + w * box.at<float>(py, px);
+      }
+  }
+
+  cv::Point at;
+  cv::minMaxLoc(response, nullptr, nullptr, nullptr, &at);
+  auto value = [&](int i, int j) {
+    return response.at<float>((i + cells.height) % cells.height, (j + cells.width) % cells.width);
+  };
+  const double dy = circular(at.y, cells.height) + refine(value(at.y - 1, at.x), value(at.y, at.x), value(at.y + 1, at.x));
+  const double dx = circular(at.x, cells.width) + refine(value(at.y, at.x - 1), value(at.y, at.x), value(at.y, at.x + 1));
+  const double px_per_cell = p_.cell * window_.width * scale_ / model_.width;
+  pos_.x = std::clamp(pos_.x + dx * px_per_cell, 0.0, frame.cols - 1.0);
+  pos_.y = std::clamp(pos_.y + dy * px_per_cell, 0.0, frame.rows - 1.0);
+  scale_ = std::clamp(scale_ * best_scale_change(frame), p_.min_scale, p_.max_scale);
+  if (learn) {
+    learn_translation(translation_features(frame, pos_, scale_), p_.learning_rate);
+    learn_scale(scale_features(frame, pos_, scale_), p_.scale_learning_rate);
+    if (p_.hist_weight > 0) learn_colour(frame, p_.hist_learning_rate);
+  }
+
+  TrackState s;
+  s.pose = {pos_.x, pos_.y, scale_, 0.0};
+  s.initial_size = target_;
+  s.confidence = confidence;
+  s.lost = !learn;
+  LevelStats level;
+  level.evaluated = static_cast<int>(response.total()) + p_.scales;
+  level.search_radius = static_cast<float>(std::min(window_.width, window_.height) * scale_ / 2);
+  s.levels.push_back(std::move(level));
+  return s;
+}
+
+}  // namespace aerie::track

@@ -1,0 +1,219 @@
+// FHOG features and the DCF tracker's own properties (the shared motion tests are in
+// test_trackers.cpp).
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "air/track/dcf/dcf.hpp"
+#include "air/track/dcf/fhog.hpp"
+#include "tests/air/track/synthetic.hpp"
+
+using namespace aerie::track;
+using aerie::track::test::Motion;
+using aerie::track::test::Scene;
+
+namespace {
+
+// Index of the channel in [first, first + count) with the largest sum.
+int strongest(const std::vector<cv::Mat>& h, int first, int count) {
+  int best = first;
+  for (int c = first; c < first + count; ++c)
+    if (cv::sum(h[c])[0] > cv::sum(h[best])[0]) best = c;
+  return best;
+}
+
+}  // namespace
+
+TEST(Fhog, CellGridAndChannels) {
+  const auto h = fhog(test::texture({67, 45}, 1, 2, 0, 255), 4);
+  ASSERT_EQ(h.size(), size_t(kFhogChannels));
+  for (const auto& c : h) {
+    EXPECT_EQ(c.size(), cv::Size(16, 11));  // floor(67 / 4) x floor(45 / 4)
+    EXPECT_EQ(c.type(), CV_32F);
+  }
+}
+
+TEST(Fhog, FlatImageHasNoFeatures) {
+  for (const auto& c : fhog(cv::Mat(32, 32, CV_8UC3, cv::Scalar(10, 200, 90)), 4)) EXPECT_EQ(cv::norm(c, cv::NORM_INF), 0.0);
+}
+
+// A ramp brightening to the right has gradient orientation 0: signed bin 0, unsigned bin 0;
+// brightening downwards: 90 degrees = signed bin 4.5 (bins 4 and 5), unsigned bins 4 and 5;
+// darkening to the right: 180 degrees = signed bin 9, unsigned bin 0 again.
+TEST(Fhog, OrientationBins) {
+  cv::Mat ramp(40, 40, CV_8U);
+  for (int y = 0; y < ramp.rows; ++y)
+    for (int x = 0; x < ramp.cols; ++x) ramp.at<uchar>(y, x) = static_cast<uchar>(5 * x);
+  auto h = fhog(ramp, 4);
+  EXPECT_EQ(strongest(h, 0, 18), 0);
+  EXPECT_EQ(strongest(h, 18, 9), 18);
+  h = fhog(ramp.t(), 4);
+  const int s = strongest(h, 0, 18);
+  EXPECT_TRUE(s == 4 || s == 5) << s;
+  EXPECT_NEAR(cv::sum(h[4])[0], cv::sum(h[5])[0], 1e-3 * cv::sum(h[4])[0]);
+  const int u = strongest(h, 18, 9);
+  EXPECT_TRUE(u == 22 || u == 23) << u;
+  cv::Mat falling;
+  cv::flip(ramp, falling, 1);
+  h = fhog(falling, 4);
+  EXPECT_EQ(strongest(h, 0, 18), 9);
+  EXPECT_EQ(strongest(h, 18, 9), 18);
+}
+
+// Every orientation feature is half the sum of four values truncated at 0.2: at most 0.4;
+// doubling the contrast leaves the features unchanged (block normalisation).
+TEST(Fhog, TruncatedAndContrastInvariant) {
+  const cv::Mat img = test::texture({48, 48}, 3, 1.5, 20, 120);
+  cv::Mat brighter;
+  img.convertTo(brighter, CV_8U, 2.0);
+  const auto a = fhog(img, 4), b = fhog(brighter, 4);
+  for (int c = 0; c < 27; ++c) {
+    double hi;
+    cv::minMaxLoc(a[c], nullptr, &hi);
+    EXPECT_LE(hi, 0.4 + 1e-6);
+    EXPECT_LT(cv::norm(a[c], b[c], cv::NORM_INF), 1e-3) << c;
+  }
+}
+
+TEST(Fhog, BadInputIsRejected) {
+  EXPECT_THROW(fhog(cv::Mat(), 4), std::invalid_argument);
+  EXPECT_THROW(fhog(cv::Mat(10, 10, CV_8U), 0), std::invalid_argument);
+  EXPECT_THROW(fhog(cv::Mat(3, 10, CV_8U), 4), std::invalid_argument);
+}
+
+namespace {
+
+// J(g) = |X G - Y|^2 + lambda / 2 |g|^2 of a real spatial filter g (the objective of masked_filter).
+double objective(const cv::Mat& g, const cv::Mat& xf, const cv::Mat& yf, double lambda) {
+  cv::Mat gf, r;
+  cv::dft(g, gf, cv::DFT_COMPLEX_OUTPUT);
+  cv::mulSpectrums(gf, xf, r, 0);
+  return std::pow(cv::norm(r - yf), 2) + lambda / 2 * std::pow(cv::norm(g), 2);
+}
+
+cv::Mat spatial(const cv::Mat& gf) {
+  cv::Mat g;
+  cv::dft(gf, g, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+  return g;
+}
+
+}  // namespace
+
+// The ADMM filter is zero outside the mask and reaches the constrained least-squares optimum,
+// solved here directly over the 25 unknowns of a 5x5 support: (D A'A + lambda/2 I) g = D A'y
+// with A's columns the circular shifts of x (D = number of cells, Parseval).
+TEST(Dcf, MaskedFilterIsTheConstrainedLeastSquaresFilter) {
+  const int n = 16, d = n * n;
+  cv::Mat x(n, n, CV_32F), y(n, n, CV_32F), mask = cv::Mat::zeros(n, n, CV_32F);
+  cv::RNG(5).fill(x, cv::RNG::NORMAL, 0, 1);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int di = i > n / 2 ? i - n : i, dj = j > n / 2 ? j - n : j;
+      y.at<float>(i, j) = std::exp(-0.5f * (di * di + dj * dj) / 2.0f);
+    }
+  mask(cv::Rect(6, 6, 5, 5)).setTo(1);
+  cv::Mat xf, yf;
+  cv::dft(x, xf, cv::DFT_COMPLEX_OUTPUT);
+  cv::dft(y, yf, cv::DFT_COMPLEX_OUTPUT);
+  DcfParams p;
+  p.lambda = 0.5;
+
+  // Direct solution.
+  cv::Mat A(d, 25, CV_64F);
+  int col = 0;
+  for (int u = 6; u < 11; ++u)
+    for (int v = 6; v < 11; ++v, ++col) {
+      cv::Mat e = cv::Mat::zeros(n, n, CV_32F), ef, r;
+      e.at<float>(u, v) = 1;
+      cv::dft(e, ef, cv::DFT_COMPLEX_OUTPUT);
+      cv::mulSpectrums(ef, xf, r, 0);
+      spatial(r).reshape(1, d).convertTo(A.col(col), CV_64F);
+    }
+  cv::Mat yv;
+  y.reshape(1, d).convertTo(yv, CV_64F);
+  const cv::Mat lhs = d * A.t() * A + p.lambda / 2 * cv::Mat::eye(25, 25, CV_64F), rhs = d * A.t() * yv;
+  cv::Mat sol;
+  ASSERT_TRUE(cv::solve(lhs, rhs, sol, cv::DECOMP_CHOLESKY));
+  cv::Mat best = cv::Mat::zeros(n, n, CV_32F);
+  col = 0;
+  for (int u = 6; u < 11; ++u)
+    for (int v = 6; v < 11; ++v, ++col) best.at<float>(u, v) = static_cast<float>(sol.at<double>(col));
+  const double optimum = objective(best, xf, yf, p.lambda);
+
+  // Unconstrained least squares cut to the mask: the naive alternative.
+  p.admm_iterations = 0;
+  const double cut = objective(spatial(masked_filter(xf, yf, mask, p)), xf, yf, p.lambda);
+  p.admm_iterations = 4;  // the tracker's setting
+  const cv::Mat g4 = spatial(masked_filter(xf, yf, mask, p));
+  p.admm_iterations = 300;
+  const cv::Mat g300 = spatial(masked_filter(xf, yf, mask, p));
+
+  cv::Mat outside;
+  cv::bitwise_not(mask > 0, outside);
+  EXPECT_LT(cv::norm(g4, cv::NORM_INF, outside), 1e-6 * cv::norm(g4, cv::NORM_INF));  // DFT round-off
+  EXPECT_LT(objective(g4, xf, yf, p.lambda), cut);
+  EXPECT_NEAR(objective(g300, xf, yf, p.lambda), optimum, 1e-3 * optimum);
+  EXPECT_LT(cv::norm(g300, best, cv::NORM_INF), 1e-3 * cv::norm(best, cv::NORM_INF));
+}
+
+// On the frame it learned from, the filter's peak is at zero shift and the scale filter's at
+// scale 1: the box does not move.
+TEST(Dcf, TheTrainingFrameGivesTheSameBox) {
+  const Scene scene({240, 180}, {40, 32});
+  Motion m;
+  m.centre = {100.3, 80.6};
+  DcfTracker t(DcfParams{});
+  t.init(scene.render(m), scene.box(m));
+  const TrackState s = t.update(scene.render(m));
+  EXPECT_NEAR(s.pose.x, m.centre.x, 0.25);
+  EXPECT_NEAR(s.pose.y, m.centre.y, 0.25);
+  EXPECT_DOUBLE_EQ(s.pose.scale, 1.0);
+  EXPECT_NEAR(s.confidence, 1.0, 1e-9);
+  ASSERT_EQ(s.levels.size(), 1u);
+  EXPECT_GT(s.levels[0].evaluated, 33);  // every cell shift + the 33 scales
+}
+
+// 12.8 px per frame over a static textured background, grey frames, window twice the target
+// per side: the spatially constrained filter follows; the unconstrained one learns the
+// background too and stays with it (why spatial_mask is on by default).
+TEST(Dcf, FastMotionOverAStaticBackground) {
+  const Scene scene({400, 320}, {40, 32});
+  auto worst_error = [&](bool spatial_mask) {
+    DcfParams p;
+    p.padding = 2.0;
+    p.spatial_mask = spatial_mask;
+    DcfTracker t(p);
+    Motion m;
+    m.centre = {80, 90};
+    cv::Mat gray;
+    cv::cvtColor(scene.render(m), gray, cv::COLOR_BGR2GRAY);
+    t.init(gray, scene.box(m));
+    double worst = 0;
+    for (int i = 1; i < 20; ++i) {
+      m.centre += cv::Point2d(10, 8);
+      cv::cvtColor(scene.render(m), gray, cv::COLOR_BGR2GRAY);
+      const TrackState s = t.update(gray);
+      worst = std::max(worst, std::hypot(s.pose.x - m.centre.x, s.pose.y - m.centre.y));
+    }
+    return worst;
+  };
+  EXPECT_LT(worst_error(true), 3.0);
+  EXPECT_GT(worst_error(false), 50.0);
+}
+
+TEST(Dcf, BadParametersAreNamed) {
+  auto message = [](auto change) {
+    DcfParams p;
+    change(p);
+    try {
+      DcfTracker t(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no exception");
+  };
+  EXPECT_NE(message([](DcfParams& p) { p.hist_bins = 30; }).find("hist_bins"), std::string::npos);
+  EXPECT_NE(message([](DcfParams& p) { p.learning_rate = 0; }).find("learning rates"), std::string::npos);
+  EXPECT_NE(message([](DcfParams& p) { p.padding = NAN; }).find("padding"), std::string::npos);
+  EXPECT_NE(message([](DcfParams& p) { p.min_scale = 2, p.max_scale = 1; }).find("min_scale"), std::string::npos);
+}
