@@ -16,8 +16,8 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("dcf: " + what);
 }
 
-// The window of `size` image pixels centred on `centre`, replicated beyond the image border,
-// resized to `out`.
+// The window of `size` image pixels centred on `centre` (a pixel of the image), replicated
+// beyond the image border, resized to `out`.
 cv::Mat subwindow(const cv::Mat& image, cv::Point2d centre, cv::Size2d size, cv::Size out) {
   const cv::Rect r(cvFloor(centre.x - size.width / 2), cvFloor(centre.y - size.height / 2),
                    std::max(1, cvRound(size.width)), std::max(1, cvRound(size.height)));
@@ -25,10 +25,6 @@ cv::Mat subwindow(const cv::Mat& image, cv::Point2d centre, cv::Size2d size, cv:
   cv::Mat patch;
   if (inside == r) {
     patch = image(r);
-  } else if (inside.empty()) {  // wholly outside: the nearest border pixel everywhere
-    const cv::Point p(std::clamp(r.x, 0, image.cols - 1), std::clamp(r.y, 0, image.rows - 1));
-    patch = cv::Mat(r.size(), image.type(), cv::Scalar::all(0));
-    patch.setTo(image.channels() == 1 ? cv::Scalar(image.at<uchar>(p)) : cv::Scalar(image.at<cv::Vec3b>(p)));
   } else {
     cv::copyMakeBorder(image(inside), patch, inside.y - r.y, r.br().y - inside.br().y, inside.x - r.x,
                        r.br().x - inside.br().x, cv::BORDER_REPLICATE);
@@ -141,8 +137,11 @@ cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask,
 
 DcfTracker::DcfTracker(DcfParams params, std::string name) : p_(params), name_(std::move(name)) { p_.validate(); }
 
-DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& frame, cv::Point2d centre, double scale) const {
-  const cv::Mat patch = subwindow(frame, centre, window_ * scale, model_);
+cv::Mat DcfTracker::window_patch(const cv::Mat& frame) const {
+  return subwindow(frame, pos_, window_ * scale_, model_);
+}
+
+DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& patch) const {
   std::vector<cv::Mat> channels = fhog(patch, p_.cell);
   cv::Mat gray;  // mean grey level per cell, centred
   cv::resize(to_gray(patch), gray, hann_.size(), 0, 0, cv::INTER_AREA);
@@ -153,10 +152,10 @@ DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& frame, cv::
   return xf;
 }
 
-cv::Mat DcfTracker::scale_features(const cv::Mat& frame, cv::Point2d centre, double scale) const {
+cv::Mat DcfTracker::scale_features(const cv::Mat& frame) const {
   cv::Mat xs;  // feature dimension x scales
   for (int i = 0; i < p_.scales; ++i) {
-    const cv::Mat patch = subwindow(frame, centre, target_ * (scale * scale_factors_[i]), scale_model_);
+    const cv::Mat patch = subwindow(frame, pos_, target_ * (scale_ * scale_factors_[i]), scale_model_);
     const std::vector<cv::Mat> h = fhog(patch, p_.cell);
     const int cells = static_cast<int>(h[0].total());
     if (xs.empty()) xs.create(cells * static_cast<int>(h.size()), p_.scales, CV_32F);
@@ -188,8 +187,7 @@ cv::Mat DcfTracker::colour_likelihood(const cv::Mat& patch) const {
   return out;
 }
 
-void DcfTracker::learn_colour(const cv::Mat& frame, double rate) {
-  const cv::Mat patch = subwindow(frame, pos_, window_ * scale_, model_);
+void DcfTracker::learn_colour(const cv::Mat& patch, double rate) {
   const cv::Mat idx = bin_index(patch, p_.hist_bins);
   const double r = model_.width / window_.width;  // model pixels per image pixel at scale 1
   const cv::Size2d target = target_ * r;
@@ -221,6 +219,15 @@ void DcfTracker::learn_colour(const cv::Mat& frame, double rate) {
   if (nb > 0) bg /= nb;
   blend(fg_hist_, fg, rate);
   blend(bg_hist_, bg, rate);
+}
+
+// Every model learns the window at the current location and scale; the first frame
+// initialises them.
+void DcfTracker::learn(const cv::Mat& frame, bool first) {
+  const cv::Mat patch = window_patch(frame);
+  learn_translation(translation_features(patch), first ? 1.0 : p_.learning_rate);
+  learn_scale(scale_features(frame), first ? 1.0 : p_.scale_learning_rate);
+  if (p_.hist_weight > 0) learn_colour(patch, first ? 1.0 : p_.hist_learning_rate);
 }
 
 void DcfTracker::learn_translation(const Spectrum& xf, double rate) {
@@ -317,15 +324,13 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   }
   cv::dft(ys, ysf_, cv::DFT_ROWS | cv::DFT_COMPLEX_OUTPUT);
 
-  learn_translation(translation_features(frame, pos_, scale_), 1.0);
-  learn_scale(scale_features(frame, pos_, scale_), 1.0);
-  if (p_.hist_weight > 0) learn_colour(frame, 1.0);
+  learn(frame, true);
   initialised_ = true;
 }
 
 // Scale: the best of the S scale samples at the current location (DSST).
 double DcfTracker::best_scale_change(const cv::Mat& frame) const {
-  const cv::Mat zsf = scale_features(frame, pos_, scale_);
+  const cv::Mat zsf = scale_features(frame);
   cv::Mat srf(1, p_.scales, CV_32FC2, cv::Scalar::all(0));
   Complex* so = cptr(srf);
   for (int r = 0; r < zsf.rows; ++r) {
@@ -346,7 +351,8 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   validate_update(name_, frame, frame_size_);
 
   // Translation response: IDFT(sum_c G_c Z_c) (spatial_mask) or IDFT(sum_c conj(A_c) Z_c / (B + lambda)).
-  const Spectrum zf = translation_features(frame, pos_, scale_);
+  const cv::Mat patch = window_patch(frame);
+  const Spectrum zf = translation_features(patch);
   cv::Mat rf(zf[0].size(), CV_32FC2, cv::Scalar::all(0));
   Complex* out = cptr(rf);
   if (p_.spatial_mask) {  // sum_c G_c Z_c
@@ -385,11 +391,10 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   const double confidence = std::clamp(std::min(cf_peak / mean_peak_, apce / mean_apce_), 0.0, 1.0);
   mean_peak_ += p_.confidence_rate * (cf_peak - mean_peak_);
   mean_apce_ += p_.confidence_rate * (apce - mean_apce_);
-  const bool learn = confidence >= p_.update_confidence;
+  const bool confident = confidence >= p_.update_confidence;
 
   // Staple: merge with the mean colour likelihood of a target-sized box at each shift.
   if (p_.hist_weight > 0) {
-    const cv::Mat patch = subwindow(frame, pos_, window_ * scale_, model_);
     cv::Mat box;
     const double r = model_.width / window_.width;
     cv::boxFilter(colour_likelihood(patch), box, CV_32F,
@@ -416,17 +421,13 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   pos_.x = std::clamp(pos_.x + dx * px_per_cell, 0.0, frame.cols - 1.0);
   pos_.y = std::clamp(pos_.y + dy * px_per_cell, 0.0, frame.rows - 1.0);
   scale_ = std::clamp(scale_ * best_scale_change(frame), p_.min_scale, p_.max_scale);
-  if (learn) {
-    learn_translation(translation_features(frame, pos_, scale_), p_.learning_rate);
-    learn_scale(scale_features(frame, pos_, scale_), p_.scale_learning_rate);
-    if (p_.hist_weight > 0) learn_colour(frame, p_.hist_learning_rate);
-  }
+  if (confident) learn(frame, false);
 
   TrackState s;
   s.pose = {pos_.x, pos_.y, scale_, 0.0};
   s.initial_size = target_;
   s.confidence = confidence;
-  s.lost = !learn;
+  s.lost = !confident;
   LevelStats level;
   level.evaluated = static_cast<int>(response.total()) + p_.scales;
   level.search_radius = static_cast<float>(std::min(window_.width, window_.height) * scale_ / 2);

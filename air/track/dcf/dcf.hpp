@@ -77,13 +77,15 @@ class DcfTracker : public Tracker {
  private:
   using Spectrum = std::vector<cv::Mat>;  // CV_32FC2 per feature channel
 
-  Spectrum translation_features(const cv::Mat& frame, cv::Point2d centre, double scale) const;
-  cv::Mat scale_features(const cv::Mat& frame, cv::Point2d centre, double scale) const;
+  cv::Mat window_patch(const cv::Mat& frame) const;  // the window at pos_ and scale_, resized
+  Spectrum translation_features(const cv::Mat& patch) const;
+  cv::Mat scale_features(const cv::Mat& frame) const;  // DFT along the scales of the S samples at pos_
   cv::Mat colour_likelihood(const cv::Mat& patch) const;
   double best_scale_change(const cv::Mat& frame) const;
   void learn_translation(const Spectrum& xf, double rate);
   void learn_scale(const cv::Mat& xsf, double rate);
-  void learn_colour(const cv::Mat& frame, double rate);
+  void learn_colour(const cv::Mat& patch, double rate);
+  void learn(const cv::Mat& frame, bool first);
 
   DcfParams p_;
   std::string name_;

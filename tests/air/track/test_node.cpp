@@ -42,14 +42,17 @@ class NodeTest : public ::testing::Test {
   aerie::image_t frame(int i) const {
     return aerie::image::to_message(scene_.render(motion(i)), 1'000'000 + 33'333 * i, i);
   }
-  void send_init(const cv::Rect2d& box, const std::string& tracker = "") {
+  // INIT with the box; a parameter override (search_radius 16) unless the tracker has none.
+  void send_init(const cv::Rect2d& box, const std::string& tracker = "", bool search_radius = true) {
     aerie::track_cmd_t c{};
     c.command = aerie::track_cmd_t::INIT;
     c.tracker = tracker;
     c.x = box.x, c.y = box.y, c.width = box.width, c.height = box.height;
-    c.nparams = 1;
-    c.param_names = {"search_radius"};
-    c.param_values = {"16"};
+    if (search_radius) {
+      c.nparams = 1;
+      c.param_names = {"search_radius"};
+      c.param_values = {"16"};
+    }
     bus_.publish("TRACK_CMD", c);
   }
 
@@ -105,6 +108,26 @@ TEST_F(NodeTest, InitThenTracksEveryFrameWithTheSourceUtime) {
   EXPECT_NEAR(poses_.back().position[0], (last.x - 120) / 200 * poses_.back().position[2], 1e-6);
   EXPECT_EQ(node.counter("frames_received"), 16);  // frame 0 came before the INIT
   EXPECT_EQ(node.counter("frames_processed") + node.counter("frames_skipped") + 1, node.counter("frames_received"));
+}
+
+// The correlation-filter tracker chosen by an INIT command, with its own parameter.
+TEST_F(NodeTest, DcfChosenByTheInitCommand) {
+  TrackNode node(bus_, NodeOptions{});
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  send_init(scene_.box(motion(0)), "dcf", false);
+  settle(node);
+  for (int i = 1; i <= 10; ++i) {
+    bus_.publish("CAM_LEFT", frame(i));
+    settle(node);
+  }
+  ASSERT_EQ(tracks_.size(), 11u);
+  const auto& last = tracks_.back();
+  EXPECT_EQ(last.tracker, "dcf");
+  EXPECT_NE(last.status, aerie::track_t::IDLE);
+  EXPECT_NEAR(last.x, motion(10).centre.x, 3);
+  EXPECT_NEAR(last.y, motion(10).centre.y, 3);
+  EXPECT_EQ(node.counter("command_errors"), 0);
 }
 
 TEST_F(NodeTest, BadMessagesAndCommandsAreCountedNotFatal) {
