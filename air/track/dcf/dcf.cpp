@@ -296,7 +296,8 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   const double support_px = p_.mask_scale * r / p_.cell;
   const cv::Size support(std::min(cells.width, static_cast<int>(std::ceil(target_.width * support_px))),
                          std::min(cells.height, static_cast<int>(std::ceil(target_.height * support_px))));
-  mask_(cv::Rect((cells.width - support.width) / 2, (cells.height - support.height) / 2, support.width, support.height)).setTo(1);
+  mask_(cv::Rect((cells.width - support.width) / 2, (cells.height - support.height) / 2, support.width, support.height))
+      .setTo(1);
 
   // Gaussian label centred on shift (0, 0), circularly.
   const double sigma = std::sqrt(target_.area()) * r / p_.cell * p_.output_sigma;
@@ -313,7 +314,8 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   scale_factors_.resize(p_.scales);
   for (int i = 0; i < p_.scales; ++i) scale_factors_[i] = std::pow(p_.scale_step, p_.scales / 2 - i);
   const double rs = std::sqrt(p_.scale_model_area / target_.area());
-  scale_model_ = {std::max(2 * p_.cell, cvRound(target_.width * rs)), std::max(2 * p_.cell, cvRound(target_.height * rs))};
+  scale_model_ = {std::max(2 * p_.cell, cvRound(target_.width * rs)),
+                  std::max(2 * p_.cell, cvRound(target_.height * rs))};
   const std::vector<float> w = hann(p_.scales);
   scale_hann_ = cv::Mat(w, true).reshape(1, 1);
   const double ssigma = p_.scale_sigma * std::sqrt(static_cast<double>(p_.scales));
@@ -415,8 +417,10 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   auto value = [&](int i, int j) {
     return response.at<float>((i + cells.height) % cells.height, (j + cells.width) % cells.width);
   };
-  const double dy = circular(at.y, cells.height) + refine(value(at.y - 1, at.x), value(at.y, at.x), value(at.y + 1, at.x));
-  const double dx = circular(at.x, cells.width) + refine(value(at.y, at.x - 1), value(at.y, at.x), value(at.y, at.x + 1));
+  const double dy =
+      circular(at.y, cells.height) + refine(value(at.y - 1, at.x), value(at.y, at.x), value(at.y + 1, at.x));
+  const double dx =
+      circular(at.x, cells.width) + refine(value(at.y, at.x - 1), value(at.y, at.x), value(at.y, at.x + 1));
   const double px_per_cell = p_.cell * window_.width * scale_ / model_.width;
   pos_.x = std::clamp(pos_.x + dx * px_per_cell, 0.0, frame.cols - 1.0);
   pos_.y = std::clamp(pos_.y + dy * px_per_cell, 0.0, frame.rows - 1.0);

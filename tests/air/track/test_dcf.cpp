@@ -34,7 +34,8 @@ TEST(Fhog, CellGridAndChannels) {
 }
 
 TEST(Fhog, FlatImageHasNoFeatures) {
-  for (const auto& c : fhog(cv::Mat(32, 32, CV_8UC3, cv::Scalar(10, 200, 90)), 4)) EXPECT_EQ(cv::norm(c, cv::NORM_INF), 0.0);
+  for (const auto& c : fhog(cv::Mat(32, 32, CV_8UC3, cv::Scalar(10, 200, 90)), 4))
+    EXPECT_EQ(cv::norm(c, cv::NORM_INF), 0.0);
 }
 
 // A ramp brightening to the right has gradient orientation 0: signed bin 0, unsigned bin 0;
