@@ -171,6 +171,9 @@ std::unique_ptr<Tracker> make_dcf(const util::Config& cfg) {
   in.read("max_scale", p.max_scale);
   in.read("update_confidence", p.update_confidence);
   in.read("confidence_rate", p.confidence_rate);
+  in.read("redetection", p.redetection);
+  in.read("lost_frames", p.lost_frames);
+  in.read("found_confidence", p.found_confidence);
   in.check_unknown();
   return std::make_unique<DcfTracker>(p);
 }

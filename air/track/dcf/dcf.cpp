@@ -99,7 +99,9 @@ void DcfParams::validate() const {
   require(inner_padding >= 0 && inner_padding < 1, "inner_padding must be in [0, 1)");
   require(scales >= 1 && scale_step > 1 && scale_model_area >= 4.0 * cell * cell * 4, "bad scale filter settings");
   require(min_scale > 0 && max_scale >= min_scale, "need 0 < min_scale <= max_scale");
-  require(update_confidence >= 0 && update_confidence <= 1, "update_confidence must be in [0, 1]");
+  require(update_confidence >= 0 && update_confidence <= 1 && found_confidence >= 0 && found_confidence <= 1,
+          "update_confidence and found_confidence must be in [0, 1]");
+  require(lost_frames >= 1, "lost_frames must be >= 1");
   require(mask_scale > 0, "mask_scale must be > 0");
   require(admm_iterations >= 0 && admm_mu > 0 && admm_beta >= 1 && admm_mu_max >= admm_mu, "bad ADMM settings");
 }
@@ -277,8 +279,8 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   pos_ = {box.x + box.width / 2, box.y + box.height / 2};
   target_ = box.size();
   scale_ = 1;
-  mean_peak_ = 0;
   frames_ = 0;
+  unconfident_frames_ = 0;
 
   // Translation window: target + padding * mean side, resized to about template_area pixels,
   // a whole number of cells of FFT-friendly count.
@@ -348,12 +350,9 @@ double DcfTracker::best_scale_change(const cv::Mat& frame) const {
   return scale_factors_[best.x];
 }
 
-TrackState DcfTracker::update(const cv::Mat& frame) {
-  if (!initialised_) throw std::invalid_argument(name_ + ": update() before init()");
-  validate_update(name_, frame, frame_size_);
-
+DcfTracker::Detection DcfTracker::detect(const cv::Mat& frame, cv::Point2d centre) const {
   // Translation response: IDFT(sum_c G_c Z_c) (spatial_mask) or IDFT(sum_c conj(A_c) Z_c / (B + lambda)).
-  const cv::Mat patch = window_patch(frame);
+  const cv::Mat patch = subwindow(frame, centre, window_ * scale_, model_);
   const Spectrum zf = translation_features(patch);
   cv::Mat rf(zf[0].size(), CV_32FC2, cv::Scalar::all(0));
   Complex* out = cptr(rf);
@@ -372,28 +371,17 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
     const float* b = den_.ptr<float>();
     for (size_t k = 0; k < rf.total(); ++k) out[k] /= b[k] + static_cast<float>(p_.lambda);
   }
-  cv::Mat response;
-  cv::dft(rf, response, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-  const cv::Size cells = response.size();
+  Detection d;
+  d.centre = centre;
+  cv::dft(rf, d.response, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+  const cv::Size cells = d.response.size();
 
   // Reliability of the filter alone: its peak and the average peak-to-correlation energy
   // (APCE, Wang et al. 2017) = (max - min)^2 / mean((F - min)^2).
-  double cf_peak, cf_min;
-  cv::minMaxLoc(response, &cf_min, &cf_peak);
-  const double apce = (cf_peak - cf_min) * (cf_peak - cf_min) /
-                      std::max(1e-12, cv::mean((response - cf_min).mul(response - cf_min))[0]);
-
-  // Confidence (LMCF's criterion): the filter's peak and APCE relative to their running means;
-  // below update_confidence (occlusion, loss) nothing is learned.
-  ++frames_;
-  if (frames_ == 1) {
-    mean_peak_ = cf_peak;
-    mean_apce_ = apce;
-  }
-  const double confidence = std::clamp(std::min(cf_peak / mean_peak_, apce / mean_apce_), 0.0, 1.0);
-  mean_peak_ += p_.confidence_rate * (cf_peak - mean_peak_);
-  mean_apce_ += p_.confidence_rate * (apce - mean_apce_);
-  const bool confident = confidence >= p_.update_confidence;
+  double cf_min;
+  cv::minMaxLoc(d.response, &cf_min, &d.peak);
+  d.apce = (d.peak - cf_min) * (d.peak - cf_min) /
+           std::max(1e-12, cv::mean((d.response - cf_min).mul(d.response - cf_min))[0]);
 
   // Staple: merge with the mean colour likelihood of a target-sized box at each shift.
   if (p_.hist_weight > 0) {
@@ -407,23 +395,75 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
       for (int j = 0; j < cells.width; ++j) {
         const int py = std::clamp(model_.height / 2 + circular(i, cells.height) * p_.cell, 0, model_.height - 1);
         const int px = std::clamp(model_.width / 2 + circular(j, cells.width) * p_.cell, 0, model_.width - 1);
-        float& v = response.at<float>(i, j);
+        float& v = d.response.at<float>(i, j);
         v = (1 - w) * v + w * box.at<float>(py, px);
       }
   }
+  return d;
+}
 
+// The merged response's peak, refined to sub-cell precision, in image pixels.
+cv::Point2d DcfTracker::peak_location(const Detection& d) const {
+  const cv::Size cells = d.response.size();
   cv::Point at;
-  cv::minMaxLoc(response, nullptr, nullptr, nullptr, &at);
+  cv::minMaxLoc(d.response, nullptr, nullptr, nullptr, &at);
   auto value = [&](int i, int j) {
-    return response.at<float>((i + cells.height) % cells.height, (j + cells.width) % cells.width);
+    return d.response.at<float>((i + cells.height) % cells.height, (j + cells.width) % cells.width);
   };
   const double dy =
       circular(at.y, cells.height) + refine(value(at.y - 1, at.x), value(at.y, at.x), value(at.y + 1, at.x));
   const double dx =
       circular(at.x, cells.width) + refine(value(at.y, at.x - 1), value(at.y, at.x), value(at.y, at.x + 1));
   const double px_per_cell = p_.cell * window_.width * scale_ / model_.width;
-  pos_.x = std::clamp(pos_.x + dx * px_per_cell, 0.0, frame.cols - 1.0);
-  pos_.y = std::clamp(pos_.y + dy * px_per_cell, 0.0, frame.rows - 1.0);
+  return d.centre + cv::Point2d(dx, dy) * px_per_cell;
+}
+
+TrackState DcfTracker::update(const cv::Mat& frame) {
+  if (!initialised_) throw std::invalid_argument(name_ + ": update() before init()");
+  validate_update(name_, frame, frame_size_);
+
+  // Confidence (LMCF's criterion): the filter's peak and APCE relative to their running means;
+  // below update_confidence (occlusion, loss) nothing is learned.
+  Detection d = detect(frame, pos_);
+  ++frames_;
+  if (frames_ == 1) {
+    mean_peak_ = d.peak;
+    mean_apce_ = d.apce;
+  }
+  auto confidence_of = [&](const Detection& c) {
+    return std::clamp(std::min(c.peak / mean_peak_, c.apce / mean_apce_), 0.0, 1.0);
+  };
+  double confidence = confidence_of(d);
+
+  // Re-detection: after lost_frames unconfident frames, the windows around the current one
+  // (3/4 of a window apart) are searched too; the best is taken if it reaches found_confidence.
+  bool redetected = false;
+  int windows = 1;
+  if (p_.redetection && unconfident_frames_ >= p_.lost_frames) {
+    const cv::Size2d step = window_ * (0.75 * scale_);
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j) {
+        if (i == 0 && j == 0) continue;
+        const cv::Point2d c(std::clamp(pos_.x + j * step.width, 0.0, frame.cols - 1.0),
+                            std::clamp(pos_.y + i * step.height, 0.0, frame.rows - 1.0));
+        Detection candidate = detect(frame, c);
+        ++windows;
+        const double conf = confidence_of(candidate);
+        if (conf >= p_.found_confidence && conf > confidence) {
+          d = std::move(candidate);
+          confidence = conf;
+          redetected = true;
+        }
+      }
+  }
+  mean_peak_ += p_.confidence_rate * (d.peak - mean_peak_);
+  mean_apce_ += p_.confidence_rate * (d.apce - mean_apce_);
+  const bool confident = confidence >= p_.update_confidence;
+  unconfident_frames_ = confident ? 0 : unconfident_frames_ + 1;
+
+  const cv::Point2d at = peak_location(d);
+  pos_.x = std::clamp(at.x, 0.0, frame.cols - 1.0);
+  pos_.y = std::clamp(at.y, 0.0, frame.rows - 1.0);
   scale_ = std::clamp(scale_ * best_scale_change(frame), p_.min_scale, p_.max_scale);
   if (confident) learn(frame, false);
 
@@ -432,8 +472,9 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   s.initial_size = target_;
   s.confidence = confidence;
   s.lost = !confident;
+  s.redetected = redetected;
   LevelStats level;
-  level.evaluated = static_cast<int>(response.total()) + p_.scales;
+  level.evaluated = static_cast<int>(d.response.total()) * windows + p_.scales;
   level.search_radius = static_cast<float>(std::min(window_.width, window_.height) * scale_ / 2);
   s.levels.push_back(std::move(level));
   return s;

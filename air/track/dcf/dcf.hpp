@@ -1,7 +1,7 @@
 #pragma once
-// DCF: a discriminative correlation filter tracker with scale adaptation and occlusion
-// handling, which the thesis names as future work for its discriminative trackers
-// (Conclusions), built from published methods:
+// DCF: a discriminative correlation filter tracker with scale adaptation and recovery of the
+// target after occlusion or loss, which the thesis names as future work for its discriminative
+// trackers (Conclusions), built from published methods:
 //
 //  * translation: a correlation filter per channel of FHOG + grey-level cells of a padded,
 //    cosine-windowed window resized to a fixed area;
@@ -10,7 +10,8 @@
 //  * scale: DSST's separate 1-D scale filter over S scales (Danelljan et al. 2014, sec. 3.2);
 //  * spatial support: the filter is constrained to the target box (CSR-DCF, Lukezic et al. 2017),
 //    so that a large window does not learn the background;
-//  * occlusion: no learning while the filter's peak or APCE is well below its running mean.
+//  * occlusion: no learning while the filter's peak or APCE is well below its running mean;
+//  * re-detection: after a few such frames the windows around the current one are searched.
 //
 // Deterministic (no randomness): the seed is unused.
 #include <complex>
@@ -23,7 +24,7 @@
 namespace aerie::track {
 
 // Defaults: Staple's, DSST's and CSR-DCF's published settings except padding, template_area,
-// mask_scale, scale_model_area and update_confidence, chosen on the shared set
+// mask_scale, scale_model_area, update_confidence and the re-detection's, chosen on the shared set
 // (docs/results/track.md, with the neighbourhood measured around them).
 struct DcfParams {
   // Translation filter.
@@ -55,7 +56,12 @@ struct DcfParams {
   // Occlusion. Confidence = min(peak, APCE) of the filter relative to their running means:
   // below update_confidence the models are not updated and the state says lost.
   double update_confidence = 0.3;
-  double confidence_rate = 0.05;   // weight of a new frame in the running mean peak
+  double confidence_rate = 0.05;   // weight of a new frame in the running means
+  // Re-detection: after lost_frames frames below update_confidence in a row, the 8 windows
+  // around the current one are searched too, and the best taken if it reaches found_confidence.
+  bool redetection = true;
+  int lost_frames = 3;
+  double found_confidence = 0.7;
 
   void validate() const;  // throws std::invalid_argument naming the bad value
 };
@@ -76,7 +82,14 @@ class DcfTracker : public Tracker {
 
  private:
   using Spectrum = std::vector<cv::Mat>;  // CV_32FC2 per feature channel
+  struct Detection {
+    cv::Point2d centre;    // of the window, image pixels
+    cv::Mat response;      // per cell shift: filter, merged with the colour likelihood
+    double peak = 0, apce = 0;  // of the filter's response alone
+  };
 
+  Detection detect(const cv::Mat& frame, cv::Point2d centre) const;
+  cv::Point2d peak_location(const Detection& d) const;
   cv::Mat window_patch(const cv::Mat& frame) const;  // the window at pos_ and scale_, resized
   Spectrum translation_features(const cv::Mat& patch) const;
   cv::Mat scale_features(const cv::Mat& frame) const;  // DFT along the scales of the S samples at pos_
@@ -112,6 +125,7 @@ class DcfTracker : public Tracker {
   cv::Mat fg_hist_, bg_hist_;  // colour histograms, normalised
   double mean_peak_ = 0, mean_apce_ = 0;
   int frames_ = 0;
+  int unconfident_frames_ = 0;  // in a row
 };
 
 }  // namespace aerie::track

@@ -202,6 +202,38 @@ TEST(Dcf, FastMotionOverAStaticBackground) {
   EXPECT_GT(worst_error(false), 50.0);
 }
 
+// The target jumps 112 px (beyond the window) after 10 frames: with re-detection the filter is
+// searched for in the windows around the last one once the confidence has stayed low, and
+// the target is found again; without, the tracker stays behind.
+TEST(Dcf, RedetectionAfterAJump) {
+  const Scene scene({320, 240}, {40, 32});
+  auto run = [&](bool redetection, int* lost, int* redetected) {
+    DcfParams p;
+    p.redetection = redetection;
+    DcfTracker t(p);
+    Motion m;
+    m.centre = {80, 90};
+    t.init(scene.render(m), scene.box(m));
+    double error = 0;
+    for (int i = 1; i < 30; ++i) {
+      m.centre += cv::Point2d(1, 0.5);
+      if (i == 10) m.centre += cv::Point2d(100, 50);
+      const TrackState s = t.update(scene.render(m));
+      *lost += s.lost;
+      *redetected += s.redetected;
+      error = std::hypot(s.pose.x - m.centre.x, s.pose.y - m.centre.y);
+    }
+    return error;
+  };
+  int lost = 0, redetected = 0;
+  EXPECT_LT(run(true, &lost, &redetected), 4.0);
+  EXPECT_GE(lost, 3);
+  EXPECT_EQ(redetected, 1);
+  lost = redetected = 0;
+  EXPECT_GT(run(false, &lost, &redetected), 100.0);
+  EXPECT_EQ(redetected, 0);
+}
+
 TEST(Dcf, BadParametersAreNamed) {
   auto message = [](auto change) {
     DcfParams p;
