@@ -137,10 +137,48 @@ cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask,
   return gm;
 }
 
+void LinearFilter::learn(const cv::Mat& xf, const cv::Mat& yf, double rate) {
+  cv::Mat num(xf.size(), CV_32FC2), den = cv::Mat::zeros(1, xf.cols, CV_32F);
+  const Complex* y = cptr(yf);
+  float* d = den.ptr<float>();
+  for (int r = 0; r < xf.rows; ++r) {
+    const Complex* x = xf.ptr<Complex>(r);
+    Complex* n = num.ptr<Complex>(r);
+    for (int k = 0; k < xf.cols; ++k) {
+      n[k] = std::conj(y[k]) * x[k];
+      d[k] += std::norm(x[k]);
+    }
+  }
+  blend(num_, num, rate);
+  blend(den_, den, rate);
+}
+
+cv::Mat LinearFilter::respond(const cv::Mat& zf, double lambda) const {
+  cv::Mat out(1, zf.cols, CV_32FC2, cv::Scalar::all(0));
+  Complex* o = cptr(out);
+  for (int r = 0; r < zf.rows; ++r) {
+    const Complex* z = zf.ptr<Complex>(r);
+    const Complex* a = num_.ptr<Complex>(r);
+    for (int k = 0; k < zf.cols; ++k) o[k] += std::conj(a[k]) * z[k];
+  }
+  const float* b = den_.ptr<float>();
+  for (int k = 0; k < zf.cols; ++k) o[k] /= b[k] + static_cast<float>(lambda);
+  return out;
+}
+
+namespace {
+// Per-channel spectra as the rows of one matrix (LinearFilter's layout).
+cv::Mat stack_rows(const std::vector<cv::Mat>& spectra) {
+  cv::Mat out(static_cast<int>(spectra.size()), static_cast<int>(spectra[0].total()), CV_32FC2);
+  for (size_t c = 0; c < spectra.size(); ++c) spectra[c].reshape(0, 1).copyTo(out.row(static_cast<int>(c)));
+  return out;
+}
+}  // namespace
+
 DcfTracker::DcfTracker(DcfParams params, std::string name) : p_(params), name_(std::move(name)) { p_.validate(); }
 
-cv::Mat DcfTracker::window_patch(const cv::Mat& frame) const {
-  return subwindow(frame, pos_, window_ * scale_, model_);
+cv::Mat DcfTracker::window_patch(const cv::Mat& frame, cv::Point2d centre) const {
+  return subwindow(frame, centre, window_ * scale_, model_);
 }
 
 DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& patch) const {
@@ -226,9 +264,9 @@ void DcfTracker::learn_colour(const cv::Mat& patch, double rate) {
 // Every model learns the window at the current location and scale; the first frame
 // initialises them.
 void DcfTracker::learn(const cv::Mat& frame, bool first) {
-  const cv::Mat patch = window_patch(frame);
+  const cv::Mat patch = window_patch(frame, pos_);
   learn_translation(translation_features(patch), first ? 1.0 : p_.learning_rate);
-  learn_scale(scale_features(frame), first ? 1.0 : p_.scale_learning_rate);
+  scale_filter_.learn(scale_features(frame), ysf_, first ? 1.0 : p_.scale_learning_rate);
   if (p_.hist_weight > 0) learn_colour(patch, first ? 1.0 : p_.hist_learning_rate);
 }
 
@@ -239,38 +277,7 @@ void DcfTracker::learn_translation(const Spectrum& xf, double rate) {
     blend(filter_, g, rate);
     return;
   }
-  // Running numerator conj(Y) X_c and denominator sum_c |X_c|^2 (Danelljan et al. 2014, eq. 5).
-  cv::Mat den = cv::Mat::zeros(xf[0].size(), CV_32F);
-  Spectrum num(xf.size());
-  const Complex* y = cptr(yf_);
-  for (size_t c = 0; c < xf.size(); ++c) {
-    num[c].create(xf[c].size(), CV_32FC2);
-    const Complex* x = cptr(xf[c]);
-    Complex* n = cptr(num[c]);
-    float* d = den.ptr<float>();
-    for (size_t k = 0; k < xf[c].total(); ++k) {
-      n[k] = std::conj(y[k]) * x[k];
-      d[k] += std::norm(x[k]);
-    }
-  }
-  blend(num_, num, rate);
-  blend(den_, den, rate);
-}
-
-void DcfTracker::learn_scale(const cv::Mat& xsf, double rate) {
-  cv::Mat num(xsf.size(), CV_32FC2), den = cv::Mat::zeros(1, xsf.cols, CV_32F);
-  const Complex* y = cptr(ysf_);
-  for (int r = 0; r < xsf.rows; ++r) {
-    const Complex* x = xsf.ptr<Complex>(r);
-    Complex* n = num.ptr<Complex>(r);
-    float* d = den.ptr<float>();
-    for (int k = 0; k < xsf.cols; ++k) {
-      n[k] = std::conj(y[k]) * x[k];
-      d[k] += std::norm(x[k]);
-    }
-  }
-  blend(snum_, num, rate);
-  blend(sden_, den, rate);
+  linear_.learn(stack_rows(xf), yf_.reshape(0, 1), rate);
 }
 
 void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
@@ -334,17 +341,9 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
 
 // Scale: the best of the S scale samples at the current location (DSST).
 double DcfTracker::best_scale_change(const cv::Mat& frame) const {
-  const cv::Mat zsf = scale_features(frame);
-  cv::Mat srf(1, p_.scales, CV_32FC2, cv::Scalar::all(0));
-  Complex* so = cptr(srf);
-  for (int r = 0; r < zsf.rows; ++r) {
-    const Complex* z = zsf.ptr<Complex>(r);
-    const Complex* a = snum_.ptr<Complex>(r);
-    for (int k = 0; k < p_.scales; ++k) so[k] += std::conj(a[k]) * z[k];
-  }
-  for (int k = 0; k < p_.scales; ++k) so[k] /= sden_.at<float>(k) + static_cast<float>(p_.scale_lambda);
   cv::Mat sresponse;
-  cv::dft(srf, sresponse, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE | cv::DFT_ROWS);
+  cv::dft(scale_filter_.respond(scale_features(frame), p_.scale_lambda), sresponse,
+          cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE | cv::DFT_ROWS);
   cv::Point best;
   cv::minMaxLoc(sresponse, nullptr, nullptr, nullptr, &best);
   return scale_factors_[best.x];
@@ -352,24 +351,19 @@ double DcfTracker::best_scale_change(const cv::Mat& frame) const {
 
 DcfTracker::Detection DcfTracker::detect(const cv::Mat& frame, cv::Point2d centre) const {
   // Translation response: IDFT(sum_c G_c Z_c) (spatial_mask) or IDFT(sum_c conj(A_c) Z_c / (B + lambda)).
-  const cv::Mat patch = subwindow(frame, centre, window_ * scale_, model_);
+  const cv::Mat patch = window_patch(frame, centre);
   const Spectrum zf = translation_features(patch);
-  cv::Mat rf(zf[0].size(), CV_32FC2, cv::Scalar::all(0));
-  Complex* out = cptr(rf);
+  cv::Mat rf;
   if (p_.spatial_mask) {  // sum_c G_c Z_c
+    rf = cv::Mat(zf[0].size(), CV_32FC2, cv::Scalar::all(0));
+    Complex* out = cptr(rf);
     for (size_t c = 0; c < zf.size(); ++c) {
       const Complex* z = cptr(zf[c]);
       const Complex* g = cptr(filter_[c]);
       for (size_t k = 0; k < rf.total(); ++k) out[k] += g[k] * z[k];
     }
   } else {
-    for (size_t c = 0; c < zf.size(); ++c) {
-      const Complex* z = cptr(zf[c]);
-      const Complex* a = cptr(num_[c]);
-      for (size_t k = 0; k < rf.total(); ++k) out[k] += std::conj(a[k]) * z[k];
-    }
-    const float* b = den_.ptr<float>();
-    for (size_t k = 0; k < rf.total(); ++k) out[k] /= b[k] + static_cast<float>(p_.lambda);
+    rf = linear_.respond(stack_rows(zf), p_.lambda).reshape(0, zf[0].rows);
   }
   Detection d;
   d.centre = centre;

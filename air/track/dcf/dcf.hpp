@@ -73,6 +73,17 @@ struct DcfParams {
 // (windowed) feature channel and the label; mask: CV_32F of 0/1, same size.
 cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask, const DcfParams& p);
 
+// A multi-channel linear correlation filter (Danelljan et al. 2014, eqs. 4-5) on spectra
+// stacked one feature channel per row (CV_32FC2): running numerator A = conj(Y) X per row and
+// denominator B = sum over rows of |X|^2; response spectrum sum over rows of conj(A) Z / (B + lambda).
+class LinearFilter {
+ public:
+  void learn(const cv::Mat& xf, const cv::Mat& yf, double rate);  // yf: one row
+  cv::Mat respond(const cv::Mat& zf, double lambda) const;         // one row
+ private:
+  cv::Mat num_, den_;
+};
+
 class DcfTracker : public Tracker {
  public:
   explicit DcfTracker(DcfParams params, std::string name = "dcf");
@@ -90,13 +101,12 @@ class DcfTracker : public Tracker {
 
   Detection detect(const cv::Mat& frame, cv::Point2d centre) const;
   cv::Point2d peak_location(const Detection& d) const;
-  cv::Mat window_patch(const cv::Mat& frame) const;  // the window at pos_ and scale_, resized
+  cv::Mat window_patch(const cv::Mat& frame, cv::Point2d centre) const;  // at scale_, resized
   Spectrum translation_features(const cv::Mat& patch) const;
   cv::Mat scale_features(const cv::Mat& frame) const;  // DFT along the scales of the S samples at pos_
   cv::Mat colour_likelihood(const cv::Mat& patch) const;
   double best_scale_change(const cv::Mat& frame) const;
   void learn_translation(const Spectrum& xf, double rate);
-  void learn_scale(const cv::Mat& xsf, double rate);
   void learn_colour(const cv::Mat& patch, double rate);
   void learn(const cv::Mat& frame, bool first);
 
@@ -112,15 +122,15 @@ class DcfTracker : public Tracker {
   cv::Size model_;       // resized window, pixels (cells x cell)
   cv::Mat hann_;         // cells
   cv::Mat yf_;           // label spectrum
-  Spectrum num_;         // conj(Y) X_c, running
-  cv::Mat den_;          // sum_c |X_c|^2, running
+  LinearFilter linear_;  // !spatial_mask: the unconstrained filter
   Spectrum filter_;      // spatial_mask: G_c per channel, running
   cv::Mat mask_;         // cells, 1 inside the target box
 
   cv::Size scale_model_;
   std::vector<double> scale_factors_;
   cv::Mat scale_hann_;   // 1 x S
-  cv::Mat ysf_, snum_, sden_;
+  cv::Mat ysf_;
+  LinearFilter scale_filter_;
 
   cv::Mat fg_hist_, bg_hist_;  // colour histograms, normalised
   double mean_peak_ = 0, mean_apce_ = 0;
