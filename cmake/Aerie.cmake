@@ -34,6 +34,10 @@ endfunction()
 # A GoogleTest executable; its tests are discovered at test time so that ctest
 # runs and reports each TEST separately. XVFB runs it under `xvfb-run -a`
 # (off-screen rendering); SERIAL keeps it from running beside other tests.
+# Discovered tests get their properties from a script ctest includes after
+# discovery: passed through gtest_discover_tests(PROPERTIES), two LABELS lose
+# their separator and shift every property after them (RUN_SERIAL was silently
+# dropped that way).
 function(aerie_test name)
   cmake_parse_arguments(A "XVFB;SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${A_SOURCES})
@@ -43,20 +47,16 @@ function(aerie_test name)
   if(NOT A_TIMEOUT)
     set(A_TIMEOUT 300)
   endif()
-  set(props TIMEOUT ${A_TIMEOUT})
-  if(A_LABELS)
-    list(APPEND props LABELS "${A_LABELS}")
-  endif()
-  if(A_SERIAL)
-    list(APPEND props RUN_SERIAL TRUE)
-  endif()
   if(A_XVFB)
     find_program(XVFB_RUN xvfb-run REQUIRED)
     add_test(NAME ${name} COMMAND ${XVFB_RUN} -a $<TARGET_FILE:${name}>)
-    set_tests_properties(${name} PROPERTIES ${props})
+    set_tests_properties(${name} PROPERTIES TIMEOUT ${A_TIMEOUT} RUN_SERIAL ${A_SERIAL} LABELS "${A_LABELS}")
   else()
-    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
-                         PROPERTIES ${props})
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_LIST ${name}_TESTS)
+    set(script ${CMAKE_CURRENT_BINARY_DIR}/${name}_properties.cmake)
+    file(WRITE ${script} "set_tests_properties(\${${name}_TESTS} PROPERTIES TIMEOUT ${A_TIMEOUT} "
+                         "RUN_SERIAL ${A_SERIAL} LABELS \"${A_LABELS}\")\n")
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${script})
   endif()
 endfunction()
 
