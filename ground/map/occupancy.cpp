@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 #include "ground/map/key_ray.hpp"
@@ -429,22 +430,31 @@ void OccupancyMap::save(const std::string& path) const {
   }
 }
 
+std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary) {
+  if (binary) {
+    auto tree = std::make_unique<octomap::OcTree>(0.1);  // readBinary sets the resolution it reads
+    if (!tree->readBinary(in)) throw std::invalid_argument("not an OctoMap binary (.bt) tree");
+    return tree;
+  }
+  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
+  if (!any) throw std::invalid_argument("not an OctoMap (.ot) tree");
+  auto* tree = dynamic_cast<octomap::OcTree*>(any.get());
+  if (tree == nullptr) throw std::invalid_argument("a " + any->getTreeType() + ", not an OcTree");
+  any.release();
+  return std::unique_ptr<octomap::OcTree>(tree);
+}
+
 std::unique_ptr<octomap::OcTree> read_octree_file(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error("map: no such file '" + path + "'");
   const std::string ext = extension_of(path);
-  if (ext == ".bt") {
-    auto tree = std::make_unique<octomap::OcTree>(0.1);  // readBinary sets the file's resolution
-    if (!tree->readBinary(path)) throw std::runtime_error("map: '" + path + "' is not a readable .bt OcTree file");
-    return tree;
+  if (ext != ".bt" && ext != ".ot")
+    throw std::runtime_error("map: cannot load '" + path + "': the extension must be .bt or .ot");
+  std::ifstream in(path, std::ios::binary);
+  try {
+    return read_octree(in, ext == ".bt");
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("map: '" + path + "' is " + e.what());
   }
-  if (ext != ".ot") throw std::runtime_error("map: cannot load '" + path + "': the extension must be .bt or .ot");
-  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(path));
-  if (!any) throw std::runtime_error("map: '" + path + "' is not a readable .ot file");
-  auto* as_octree = dynamic_cast<octomap::OcTree*>(any.get());
-  if (as_octree == nullptr)
-    throw std::runtime_error("map: '" + path + "' holds a " + any->getTreeType() + ", expected an OcTree");
-  any.release();
-  return std::unique_ptr<octomap::OcTree>(as_octree);
 }
 
 void OccupancyMap::load(const std::string& path) {

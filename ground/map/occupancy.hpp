@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <istream>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -64,8 +65,11 @@ struct OccupancyParams {
   void validate() const;  // throws std::invalid_argument naming the key
 };
 
-// A saved OctoMap OcTree, .bt (binary) or .ot (full), chosen by extension, at the file's
-// resolution. Throws std::runtime_error naming the path and what is wrong.
+// An OctoMap OcTree, at its own resolution, from the content of a .bt file (`binary`:
+// occupied/free) or a .ot file (full probabilities). Throws std::invalid_argument saying
+// what the content is instead ("not an OctoMap binary (.bt) tree", ...).
+std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary);
+// The same from a file, .bt or .ot by extension. Throws std::runtime_error naming the path.
 std::unique_ptr<octomap::OcTree> read_octree_file(const std::string& path);
 
 enum class Occupancy : int8_t { Unknown = 0, Free = 1, Occupied = 2 };

@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "ground/map/occupancy.hpp"
+
 namespace aerie::map {
 
 void encode_octree(const octomap::OcTree& tree, bool binary, aerie::octomap_t& msg) {
@@ -24,16 +26,11 @@ std::unique_ptr<octomap::OcTree> decode_octree(const aerie::octomap_t& msg) {
     throw std::invalid_argument("octomap_t: length disagrees with the payload size");
   if (!(msg.resolution > 0)) throw std::invalid_argument("octomap_t: resolution must be positive");
   std::istringstream in(std::string(msg.data.begin(), msg.data.end()));
-  if (msg.binary) {
-    auto tree = std::make_unique<octomap::OcTree>(msg.resolution);
-    if (!tree->readBinary(in)) throw std::invalid_argument("octomap_t: payload is not an OctoMap binary tree");
-    return tree;
+  try {
+    return read_octree(in, msg.binary);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("octomap_t: payload is ") + e.what());
   }
-  std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
-  auto* tree = dynamic_cast<octomap::OcTree*>(any.get());
-  if (!tree) throw std::invalid_argument("octomap_t: payload is not an OctoMap OcTree");
-  any.release();
-  return std::unique_ptr<octomap::OcTree>(tree);
 }
 
 }  // namespace aerie::map
