@@ -219,7 +219,7 @@ struct OctomapRenderer::Map {
   std::deque<std::pair<std::unique_ptr<octomap::OcTree>, bool>> inbox;  // parsed messages, full?
   int coarsening = 0;
   size_t max_quads = 0;
-  uint64_t settings = 1;  // bumped when coarsening or max_quads change
+  uint64_t settings = 1;  // bumped when coarsening changes
   bool stop = false;
   std::optional<Surface> ready;  // the newest surface, until the render thread takes it
   std::thread mesher;
@@ -286,7 +286,6 @@ OctomapRenderer::~OctomapRenderer() {
   map_->mesher.join();
 }
 
-
 void OctomapRenderer::subscribe(bus::Bus& bus) {
   bus.subscribe<aerie::octomap_t>(
       channel_,
@@ -321,15 +320,6 @@ void OctomapRenderer::attach(Layout& layout) {
   label_->GetTextProperty()->SetColor(0.8, 0.8, 0.8);
   label_->SetPosition(6, 6);
   layout.scene->AddActor2D(label_);
-}
-
-void OctomapRenderer::set_max_quads(size_t n) {
-  {
-    std::lock_guard lock(map_->m);
-    map_->max_quads = n;
-    ++map_->settings;
-  }
-  map_->wake.notify_one();
 }
 
 void OctomapRenderer::set_coarsening(int levels) {

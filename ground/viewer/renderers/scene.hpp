@@ -85,7 +85,7 @@ class DepthCloudRenderer : public Renderer {
   std::string channel_;
   Latest<std::vector<Eigen::Vector3f>> cloud_;
   uint64_t seen_ = 0;
-  size_t shown_ = 0, quads_ = 0;
+  size_t shown_ = 0;
   vtkSmartPointer<vtkActor> actor_;
 };
 
@@ -106,7 +106,6 @@ class OctomapRenderer : public Renderer {
   void set_coarsening(int levels);
   int coarsening() const { return coarsening_; }
   int coarsening_shown() const { return shown_coarsening_; }  // after the quad budget
-  void set_max_quads(size_t n);
   size_t voxels_shown() const { return shown_; }
   size_t quads_shown() const { return quads_; }
 
