@@ -1,7 +1,7 @@
 #pragma once
 // Typed publish/subscribe over LCM 1.3, whose C++ API has no lambda subscribe.
-// A subscription decodes the message itself, so a corrupt payload is counted and
-// logged instead of reaching the handler; a handler that throws is counted too.
+// A subscription decodes the message itself, bounded (wire.hpp), so a corrupt or hostile
+// payload is counted and logged instead of reaching the handler; a handler that throws is counted too.
 // Gaps in `seq` are counted as drops (LCM drops silently when a queue is full).
 #include <lcm/lcm-cpp.hpp>
 
@@ -14,6 +14,8 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "common/bus/wire.hpp"
 
 namespace aerie::bus {
 
@@ -63,10 +65,7 @@ class TypedSubscription final : public Subscription {
 
  private:
   void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
-    Msg msg;
-    if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0)
-      throw std::invalid_argument("cannot decode " + std::string(Msg::getTypeName()) + " (" +
-                                  std::to_string(rbuf->data_size) + " bytes; wrong type or corrupt payload)");
+    const Msg msg = decode_bounded<Msg>(rbuf->data, rbuf->data_size);  // throws std::invalid_argument
     if constexpr (HasSeq<Msg>) note_seq(msg.seq);
     handler_(msg, ReceiveInfo{channel, rbuf->recv_utime, rbuf->data_size});
   }

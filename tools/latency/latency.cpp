@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/bus/bus.hpp"
+#include "common/bus/wire.hpp"
 #include "tools/log/type_registry.hpp"
 
 namespace aerie::latency {
@@ -53,7 +54,7 @@ void LatencyAnalysis::add(const std::string& channel, int64_t log_utime, const u
   // Per hop, from the nodes' heartbeats (whatever the channel filter).
   if (channel.rfind("STATUS_", 0) == 0 && fp == aerie::process_status_t::getHash()) {
     aerie::process_status_t st;
-    if (st.decode(data, 0, static_cast<int>(size)) >= 0 && st.last_source_utime > 0 && st.last_receive_utime > 0 &&
+    if (bus::decode_bounded(data, size, st) && st.last_source_utime > 0 && st.last_receive_utime > 0 &&
         st.last_publish_utime > 0) {
       HopAcc& h = hops_[st.node.empty() ? channel.substr(7) : st.node];
       // A heartbeat of an idle node repeats its last hop: count each hop once.

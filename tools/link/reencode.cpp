@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "common/bus/wire.hpp"
 #include "common/image/image_message.hpp"
 
 namespace aerie::link {
@@ -37,16 +38,15 @@ std::vector<uint8_t> encode(const Msg& m) {
 std::optional<std::vector<uint8_t>> reencode_jpeg(const std::vector<uint8_t>& payload, int quality) {
   if (payload.size() < 8) return std::nullopt;
   const uint64_t fp = fingerprint(payload);
-  const int size = static_cast<int>(payload.size());
   std::vector<uint8_t> out;
   try {
     if (fp == static_cast<uint64_t>(aerie::image_t::getHash())) {
       aerie::image_t m;
-      if (m.decode(payload.data(), 0, size) != size) return std::nullopt;
+      if (!bus::decode_bounded(payload.data(), payload.size(), m)) return std::nullopt;
       out = encode(to_jpeg(m, quality));
     } else if (fp == static_cast<uint64_t>(aerie::stereo_image_t::getHash())) {
       aerie::stereo_image_t m;
-      if (m.decode(payload.data(), 0, size) != size) return std::nullopt;
+      if (!bus::decode_bounded(payload.data(), payload.size(), m)) return std::nullopt;
       m.left = to_jpeg(m.left, quality);
       m.right = to_jpeg(m.right, quality);
       out = encode(m);

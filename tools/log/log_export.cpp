@@ -13,6 +13,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "common/bus/wire.hpp"
 #include "common/image/image_message.hpp"
 #include "tools/log/type_registry.hpp"
 
@@ -55,7 +56,7 @@ class Exporter {
 
 template <typename Msg>
 bool decode(const logio::Event& ev, Msg& m) {
-  return m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) >= 0;
+  return bus::decode_bounded(ev.data.data(), ev.data.size(), m);
 }
 
 class ImageExporter final : public Exporter {
