@@ -4,56 +4,32 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/util/section_reader.hpp"
+
 namespace aerie::sim {
 
-namespace {
-
-// Reads the keys of one section into a struct, each key named once; finish() then rejects
-// any key of the section that was not read (a typo would otherwise be silently ignored).
-template <typename S>
-class SectionReader {
- public:
-  SectionReader(const util::Config& section, S& out) : c_(section), out_(out) {}
-  template <typename T>
-  SectionReader& operator()(const std::string& key, T S::*member) {
-    out_.*member = c_.get<T>(key, out_.*member);
-    known_.push_back(key);
-    return *this;
-  }
-  void finish() const {
-    const YAML::Node& n = c_.node();
-    if (!n || n.IsNull()) return;
-    if (!n.IsMap()) throw std::runtime_error(c_.origin() + ": expected a map of keys");
-    for (const auto& kv : n) {
-      const std::string key = kv.first.as<std::string>();
-      if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
-      std::string list;
-      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
-      throw std::runtime_error(c_.origin() + ": unknown key '" + key + "' (known: " + list + ")");
-    }
-  }
-
- private:
-  const util::Config& c_;
-  S& out_;
-  std::vector<std::string> known_;
-};
-
-}  // namespace
+using util::SectionReader;
 
 WorldConfig load_world_config(const util::Config& c) {
   WorldConfig w;
   using W = WorldConfig;
-  SectionReader<W>(c, w)("seed", &W::seed)("room_x", &W::room_x)("room_y", &W::room_y)("room_z", &W::room_z)(
-      "n_obstacles", &W::n_obstacles)("helipad_size", &W::helipad_size)("helipad_yaw_deg", &W::helipad_yaw_deg)(
+  SectionReader<W>(c, w)("kind", &W::kind)("seed", &W::seed)("room_x", &W::room_x)("room_y", &W::room_y)(
+      "room_z", &W::room_z)("n_obstacles", &W::n_obstacles)("helipad_size", &W::helipad_size)(
+      "helipad_yaw_deg", &W::helipad_yaw_deg)("helipad_x", &W::helipad_x)("helipad_y", &W::helipad_y)(
       "texels_per_metre", &W::texels_per_metre)("route_margin", &W::route_margin)(
-      "route_clearance", &W::route_clearance)("cruise_altitude", &W::cruise_altitude)
+      "route_clearance", &W::route_clearance)("cruise_altitude", &W::cruise_altitude)("field_x", &W::field_x)(
+      "field_y", &W::field_y)("sky_z", &W::sky_z)("field_texels_per_metre", &W::field_texels_per_metre)(
+      "vehicle_texels_per_metre", &W::vehicle_texels_per_metre)("vehicle_length", &W::vehicle_length)(
+      "vehicle_width", &W::vehicle_width)("vehicle_height", &W::vehicle_height)(
+      "vehicle_yaw_deg", &W::vehicle_yaw_deg)("road_width", &W::road_width)("sun_azimuth_deg", &W::sun_azimuth_deg)(
+      "sun_elevation_deg", &W::sun_elevation_deg)
       .finish();
+  if (w.kind != "room" && w.kind != "field")
+    throw std::runtime_error(c.origin() + ": key 'kind' must be room or field (got '" + w.kind + "')");
   return w;
 }
 
-RigConfig load_rig_config(const util::Config& c) {
-  RigConfig r;
+RigConfig load_rig_config(const util::Config& c, RigConfig r) {
   using R = RigConfig;
   SectionReader<R>(c, r)("width", &R::width)("height", &R::height)("baseline", &R::baseline)(
       "hfov_deg", &R::hfov_deg)("vfov_deg", &R::vfov_deg)("pitch_deg", &R::pitch_deg)("color", &R::color)(
@@ -110,7 +86,7 @@ Trajectory make_trajectory(const World& world, const TrajectoryConfig& t) {
 }
 
 StereoSimulation make_simulation(const SimulationConfig& s) {
-  World world = World::room(s.world);
+  World world = World::make(s.world);
   Trajectory trajectory = make_trajectory(world, s.trajectory);
   return StereoSimulation(std::move(world), s.rig, std::move(trajectory), s.trajectory.rate_hz,
                           s.trajectory.start_utime);

@@ -1,7 +1,8 @@
 #pragma once
 // The simulator's YAML configuration (config/sim/*.yaml): sections `world`, `rig`,
 // `trajectory` and `intruder`, every key optional (defaults are the structs' defaults),
-// unknown keys rejected with the file and key named.
+// unknown keys rejected with the file and key named. The world's `kind` (room | field)
+// chooses World::room or World::field (make_simulation builds it with World::make).
 #include <cstdint>
 #include <string>
 
@@ -26,7 +27,8 @@ struct SimulationConfig {
 };
 
 WorldConfig load_world_config(const util::Config& section);
-RigConfig load_rig_config(const util::Config& section);
+// Keys absent from the section keep the values of `base`.
+RigConfig load_rig_config(const util::Config& section, RigConfig base = {});
 TrajectoryConfig load_trajectory_config(const util::Config& section);
 IntruderConfig load_intruder_config(const util::Config& section);
 // The `world`, `rig` and `trajectory` sections of a file (or of an empty Config: defaults).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace aerie::sim {
 
@@ -225,6 +226,74 @@ void draw_panels(cv::Mat& img, double density, cv::RNG& rng) {
     }
 }
 
+// Grass: many short blades (anti-aliased strokes, lighter or darker than the ground under
+// them) in clumps, on a dark multi-scale noise.
+void draw_grass(cv::Mat& img, double density, cv::RNG& rng) {
+  const double area = img.cols * img.rows / (density * density);
+  const int n = static_cast<int>(area * 200.0);
+  constexpr int kShift = 4;
+  const double sub = 1 << kShift;
+  for (int i = 0; i < n; ++i) {
+    const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), rng.uniform(0.0, 1.0 * img.rows));
+    const double len = density * rng.uniform(0.015, 0.05), a = rng.uniform(0.0, CV_PI);
+    const float below = img.at<float>(std::min(static_cast<int>(c.y), img.rows - 1),
+                                      std::min(static_cast<int>(c.x), img.cols - 1));
+    const cv::Scalar col(std::clamp(below + rng.uniform(-0.14, 0.18), 0.0, 1.0));
+    cv::line(img, cv::Point(cvRound(c.x * sub), cvRound(c.y * sub)),
+             cv::Point(cvRound((c.x + len * std::cos(a)) * sub), cvRound((c.y + len * std::sin(a)) * sub)), col,
+             1, cv::LINE_AA, kShift);
+  }
+}
+
+// Road markings on an asphalt strip whose rows run across the road: white edge lines
+// 0.25 m from both edges and a dashed centre line (dashes and gaps of random length).
+void draw_road_markings(cv::Mat& img, double density, cv::RNG& rng) {
+  const int w = std::max(1, cvRound(0.12 * density));
+  auto paint = [&](cv::Rect r) {
+    r &= cv::Rect(0, 0, img.cols, img.rows);
+    if (r.area() > 0) img(r) = 0.3 * img(r) + 0.62;  // worn white paint: the asphalt shows through
+  };
+  if (img.rows > 4 * w + cvRound(density)) {
+    const int edge = cvRound(0.25 * density);
+    paint(cv::Rect(0, edge, img.cols, w));
+    paint(cv::Rect(0, img.rows - edge - w, img.cols, w));
+  }
+  double x = -rng.uniform(0.0, 3.0) * density;
+  while (x < img.cols) {
+    const double dash = rng.uniform(2.5, 3.5) * density;
+    paint(cv::Rect(cvRound(x), (img.rows - w) / 2, cvRound(dash), w));
+    x += dash + rng.uniform(3.0, 4.5) * density;
+  }
+}
+
+// Bright, nearly uniform sky with faint clouds of a few metres.
+cv::Mat sky(cv::Size size, double density, uint64_t seed) {
+  return stretch(value_noise(size, 6.0 * density, 4, 0.5, mix_seed(seed, 11)), 0.84, 0.88);
+}
+
+// A dark treeline, 1.5-5 m high with a ragged top, along the bottom rows of a sky face.
+void draw_treeline(cv::Mat& img, const cv::Mat& foliage, double density, uint64_t seed) {
+  const cv::Mat profile = value_noise(cv::Size(img.cols, 2), 3.0 * density, 6, 0.6, mix_seed(seed, 12));
+  for (int u = 0; u < img.cols; ++u) {
+    const double top = img.rows - (1.5 + 3.5 * profile.at<float>(0, u)) * density;  // row of the tree tops
+    for (int v = std::max(0, static_cast<int>(top)); v < img.rows; ++v) {
+      const float cover = static_cast<float>(std::clamp(v + 1.0 - top, 0.0, 1.0));  // anti-aliased top
+      const float leaf = 0.1f + 0.3f * (foliage.at<float>(v, u) - 0.2f);
+      img.at<float>(v, u) += cover * (leaf - img.at<float>(v, u));
+    }
+  }
+}
+
+// Car panel seams: a few dark lines across and along the face.
+void draw_seams(cv::Mat& img, double density, cv::RNG& rng) {
+  const int w = std::max(1, cvRound(0.006 * density));
+  const int across = rng.uniform(2, 5), along = rng.uniform(1, 3);
+  for (int i = 0; i < across; ++i)
+    cv::rectangle(img, cv::Rect(rng.uniform(0, img.cols), 0, w, img.rows), cv::Scalar(0.15), cv::FILLED);
+  for (int i = 0; i < along; ++i)
+    cv::rectangle(img, cv::Rect(0, rng.uniform(0, img.rows), img.cols, w), cv::Scalar(0.15), cv::FILLED);
+}
+
 }  // namespace
 
 cv::Mat make_texture(Material material, double width_m, double height_m, double density, uint64_t seed) {
@@ -254,6 +323,34 @@ cv::Mat make_texture(Material material, double width_m, double height_m, double 
       break;
     case Material::Pillar:
       scatter_marks(img, density, 80.0, rng, 0.6);
+      break;
+    case Material::Grass:
+      img = 0.5 * img + 0.05;  // darker than indoor surfaces
+      draw_grass(img, density, rng);
+      scatter_marks(img, density, 2.0, rng, 0.2);  // stones, flowers
+      break;
+    case Material::Asphalt: {
+      img = 0.12 * img + 0.12;  // darker and smoother than the grass
+      cv::Mat grain(size, CV_32F);
+      rng.fill(grain, cv::RNG::UNIFORM, -0.05, 0.05);
+      img += grain;
+      scatter_marks(img, density, 8.0, rng, 0.4);  // stains, cracks
+      draw_road_markings(img, density, rng);
+      break;
+    }
+    case Material::Sky:
+      img = sky(size, density, seed);
+      break;
+    case Material::Horizon: {
+      const cv::Mat foliage = img;
+      img = sky(size, density, seed);
+      draw_treeline(img, foliage, density, seed);
+      break;
+    }
+    case Material::Vehicle:
+      img = 0.2 * img + 0.4;  // smooth paint
+      draw_seams(img, density, rng);
+      scatter_marks(img, density, 6.0, rng, 0.4);  // dirt
       break;
   }
   cv::Mat out;

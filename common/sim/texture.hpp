@@ -63,11 +63,17 @@ class MipTexture {
 };
 
 // What a surface looks like; each kind has its own procedural generator.
-enum class Material { Floor, Wall, Ceiling, Crate, Pillar };
+// Room: Floor, Wall, Ceiling, Crate, Pillar. Field: Grass (ground), Asphalt (a road strip:
+// rows across the road, white edge lines and a dashed centre line), Sky (bright, nearly
+// uniform, faint clouds; emissive, not lit), Horizon (Sky with a dark treeline along the
+// bottom rows: the field's side faces), Vehicle (smooth car paint with panel seams).
+enum class Material { Floor, Wall, Ceiling, Crate, Pillar, Grass, Asphalt, Sky, Horizon, Vehicle };
 
 // A procedural texture of a (width_m x height_m) surface at `texels_per_metre`, seeded.
 // Multi-scale value noise plus a kind-specific pattern (tiles, bricks with posters, ceiling
-// panels, crate planks, concrete) plus scattered sharp marks, none of them periodic.
+// panels, crate planks, concrete, grass blades, road markings, clouds, treeline, car
+// panels) plus scattered sharp marks, none of them periodic. Image rows run along
+// height_m; for Horizon the last rows are the bottom of the face.
 cv::Mat make_texture(Material material, double width_m, double height_m, double texels_per_metre,
                      uint64_t seed);
 

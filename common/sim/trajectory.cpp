@@ -206,7 +206,7 @@ Trajectory Trajectory::demo_flight(const World& world, double speed) {
   const Eigen::Vector3d ground(r.home.x(), r.home.y(), kGroundHeight);
   const Eigen::Vector3d home(r.home.x(), r.home.y(), r.altitude);
   const Eigen::Vector3d above_pad(pad.center.x(), pad.center.y(), r.altitude);
-  const Eigen::Vector3d on_pad(pad.center.x(), pad.center.y(), kGroundHeight);
+  const Eigen::Vector3d on_pad(pad.center.x(), pad.center.y(), pad.center.z() + kGroundHeight);  // the pad may be on an object
   const double yaw_loop = -0.5 * kPi;
   const double yaw_pad = std::atan2(above_pad.y() - home.y(), above_pad.x() - home.x());
   Trajectory t;
