@@ -3,6 +3,7 @@
 #include <aerie/target_pose_t.hpp>
 #include <spdlog/spdlog.h>
 
+#include <charconv>
 #include <chrono>
 
 #include "air/track/factory.hpp"
@@ -36,6 +37,16 @@ NodeOptions node_options(const util::Config& cfg) {
   o.target.yaw_offset = target.get("yaw_offset_deg", 0.0) * M_PI / 180;
   if (o.target.width_m < 0 || o.target.height_m < 0)
     throw std::runtime_error(cfg.origin() + ": target.width_m and target.height_m must be >= 0");
+  const std::string shape = target.get<std::string>("shape", "box");
+  if (shape != "box" && shape != "square")
+    throw std::runtime_error(cfg.origin() + ": target.shape must be box or square, got '" + shape + "'");
+  o.target_shape = shape == "square" ? TargetShape::Square : TargetShape::Box;
+  o.pad_border = target.get("border", o.pad_border);
+  o.search_margin = target.get("search_margin", o.search_margin);
+  o.reseed_iou = target.get("reseed_iou", o.reseed_iou);
+  if (!(o.pad_border >= 0 && o.pad_border < 0.25)) throw std::runtime_error(cfg.origin() + ": target.border must be in [0, 0.25)");
+  if (!(o.search_margin >= 0)) throw std::runtime_error(cfg.origin() + ": target.search_margin must be >= 0");
+  if (!(o.reseed_iou >= 0 && o.reseed_iou <= 1)) throw std::runtime_error(cfg.origin() + ": target.reseed_iou must be in [0, 1]");
 
   const util::Config cam = cfg.section("camera");
   if (cam.has("calibration")) {
@@ -54,8 +65,45 @@ NodeOptions node_options(const util::Config& cfg) {
   return o;
 }
 
+namespace {
+// Intrinsics an image brings in its metadata ("fx", "fy", "cx", "cy", decimal ASCII): nullopt
+// when it brings none; throws std::invalid_argument naming the key when one is missing or bad.
+std::optional<camera::CameraModel> metadata_camera(const aerie::image_t& m) {
+  const char* keys[] = {"fx", "fy", "cx", "cy"};
+  double v[4];
+  int found = 0;
+  for (int i = 0; i < 4; ++i) {
+    const std::optional<std::string> text = image::metadata(m, keys[i]);
+    if (!text) continue;
+    ++found;
+    const char* end = text->data() + text->size();
+    const auto [ptr, ec] = std::from_chars(text->data(), end, v[i]);
+    if (ec != std::errc() || ptr != end || !std::isfinite(v[i]))
+      throw std::invalid_argument(std::string("metadata ") + keys[i] + ": not a number: '" + *text + "'");
+  }
+  if (found == 0) return std::nullopt;
+  if (found < 4) throw std::invalid_argument("metadata intrinsics need all of fx, fy, cx, cy");
+  camera::CameraModel c;
+  c.width = m.width, c.height = m.height;
+  c.fx = v[0], c.fy = v[1], c.cx = v[2], c.cy = v[3];
+  c.validate("metadata intrinsics");
+  return c;
+}
+
+double iou(const cv::Rect2d& a, const cv::Rect2d& b) {
+  const double u = (a | b).area();
+  return u > 0 ? (a & b).area() / u : 0;
+}
+}  // namespace
+
 TrackNode::TrackNode(bus::Bus& bus, NodeOptions options) : bus_(bus), opt_(std::move(options)) {
   if (!is_known_tracker(opt_.tracker)) throw std::invalid_argument("unknown tracker '" + opt_.tracker + "'");
+  if (opt_.target_shape == TargetShape::Square) {
+    if (!(opt_.target.width_m > 0)) throw std::invalid_argument("target.shape square needs target.width_m > 0 (the pad's side)");
+    if (!(opt_.pad_border >= 0 && opt_.pad_border < 0.25)) throw std::invalid_argument("target.border must be in [0, 0.25)");
+    if (!(opt_.search_margin >= 0)) throw std::invalid_argument("target.search_margin must be >= 0");
+    if (!(opt_.reseed_iou >= 0 && opt_.reseed_iou <= 1)) throw std::invalid_argument("target.reseed_iou must be in [0, 1]");
+  }
   tracker_params_ = opt_.trackers.section(opt_.tracker);
   if (opt_.stereo) {
     bus_.subscribe<aerie::stereo_image_t>(opt_.camera_channel, [this](const aerie::stereo_image_t& m,
@@ -68,7 +116,14 @@ TrackNode::TrackNode(bus::Bus& bus, NodeOptions options) : bus_(bus), opt_(std::
     });
   } else {
     bus_.subscribe<aerie::image_t>(opt_.camera_channel, [this](const aerie::image_t& m, const bus::ReceiveInfo& info) {
-      on_frame({m, info.recv_utime, std::nullopt});
+      std::optional<camera::CameraModel> cam;
+      try {
+        cam = metadata_camera(m);
+      } catch (const std::exception& e) {  // keep the configured camera
+        count("camera_metadata_errors");
+        fail(opt_.camera_channel + ": " + e.what() + " (configured camera kept)");
+      }
+      on_frame({m, info.recv_utime, cam});
     });
   }
   bus_.subscribe<aerie::track_cmd_t>(opt_.command_channel,
@@ -196,13 +251,15 @@ void TrackNode::run() {
       }
       if (gt) {
         try {
-          start_tracker(opt_.tracker, opt_.trackers.section(opt_.tracker), {gt->x, gt->y, gt->width, gt->height});
+          // A box "visible" up to half a pixel outside the image is cut to it (trackers refuse it otherwise).
+          const cv::Rect2d box = cv::Rect2d(gt->x, gt->y, gt->width, gt->height) &
+                                 cv::Rect2d(0, 0, last_frame_.cols, last_frame_.rows);
+          start_tracker(opt_.tracker, opt_.trackers.section(opt_.tracker), box);
           gt_init_done_ = initialised_now = true;
           spdlog::info("initialised {} on the {} box from {}", opt_.tracker, gt->target, opt_.gt_channel);
         } catch (const std::exception& e) {
-          count("command_errors");
+          count("command_errors");  // tried again on the next frame's box
           fail(opt_.gt_channel + ": " + e.what());
-          gt_init_done_ = true;
         }
       }
     }
@@ -233,6 +290,7 @@ void TrackNode::start_tracker(const std::string& name, const util::Config& param
   tracker_name_ = name;
   tracker_params_ = params;
   last_box_ = box;
+  last_pad_box_ = {};
 }
 
 namespace {
@@ -304,7 +362,9 @@ void TrackNode::process(const Frame& frame) {
     count("frames_processed");
     if (s.lost) count("lost_frames");
     if (s.redetected) count("redetections");
-    publish(frame, &s, ms);
+    std::optional<PadObservation> pad;
+    if (opt_.target_shape == TargetShape::Square && !s.lost && last_camera_) pad = refine(s);
+    publish(frame, &s, ms, pad ? &*pad : nullptr);
   } catch (const std::exception& e) {
     count("track_errors");
     fail(tracker_name_ + ": " + e.what() + " (tracking stopped)");
@@ -314,7 +374,37 @@ void TrackNode::process(const Frame& frame) {
   }
 }
 
-void TrackNode::publish(const Frame& frame, const TrackState* s, double ms) {
+// The pad's corners in the tracker's box grown by the margin (and at least as large as the
+// last pad seen: the tracker's scale may lag the descent); re-seeds a tracker that disagrees.
+std::optional<PadObservation> TrackNode::refine(const TrackState& s) {
+  const cv::Rect2d box = s.box();
+  const double w = std::max(box.width, last_pad_box_.width) * (1 + 2 * opt_.search_margin);
+  const double h = std::max(box.height, last_pad_box_.height) * (1 + 2 * opt_.search_margin);
+  const cv::Rect2d search(s.pose.x - w / 2, s.pose.y - h / 2, w, h);
+  PadMiss miss = PadMiss::None;
+  std::optional<PadObservation> pad;
+  try {
+    pad = observe_pad(last_frame_, search, *last_camera_, {opt_.target.width_m, opt_.pad_border}, {}, &miss);
+  } catch (const std::exception& e) {  // e.g. a configured camera of another size than the frames
+    count("pad_errors");
+    fail(opt_.pose_channel + ": " + e.what());
+    return std::nullopt;
+  }
+  if (!pad) {
+    count("pad_not_found");
+    count("pad_miss_" + to_string(miss));
+    return pad;
+  }
+  count("pad_refined");
+  if (opt_.reseed_iou > 0 && iou(pad->box, box) < opt_.reseed_iou) {
+    start_tracker(tracker_name_, tracker_params_, pad->box);  // same tracker and parameters, new box
+    count("tracker_reseeded");
+  }
+  last_pad_box_ = pad->box;
+  return pad;
+}
+
+void TrackNode::publish(const Frame& frame, const TrackState* s, double ms, const PadObservation* pad) {
   aerie::track_t m{};
   m.utime = frame.image.utime;
   m.seq = seq_++;
@@ -357,12 +447,11 @@ void TrackNode::publish(const Frame& frame, const TrackState* s, double ms) {
     }
     m.nlevels = static_cast<int32_t>(m.levels.size());
   }
-  bus_.publish(opt_.track_channel, m);
-  count("tracks_published");
-
+  // TARGET_POSE goes first: TRACK closes the frame (aerie-pilot ticks on it, with this frame's pose).
   if (s && !s->lost && opt_.target.width_m > 0 && last_camera_) {
     try {
-      const TargetPose p = target_pose(*s, *last_camera_, opt_.target);
+      // The refined pad when found (yaw modulo pi, absolute), else the box-based estimate.
+      const TargetPose p = pad ? TargetPose{pad->position, pad->yaw} : target_pose(*s, *last_camera_, opt_.target);
       aerie::target_pose_t tp{};
       tp.utime = m.utime;
       tp.seq = pose_seq_++;
@@ -377,6 +466,9 @@ void TrackNode::publish(const Frame& frame, const TrackState* s, double ms) {
       fail(opt_.pose_channel + ": " + e.what());
     }
   }
+  bus_.publish(opt_.track_channel, m);
+  count("tracks_published");
+
   std::lock_guard lk(mutex_);
   hop_source_ = m.utime;
   hop_receive_ = frame.receive_utime;

@@ -3,7 +3,9 @@
 // (aerie.image_t, or aerie.stereo_image_t whose left image is tracked), TRACK_CMD (operator
 // commands) and optionally GT_TRACK (simulator ground truth, to initialise without an
 // operator); publishes TRACK for every processed frame with the source frame's utime and
-// TARGET_POSE when the target's size and the camera intrinsics are known.
+// TARGET_POSE when the target's size and the camera intrinsics are known: from the box size
+// (target shape "box"), or for a square pad from its corners found in the tracker's box
+// (shape "square", landing/pad_pose.hpp), which also re-seeds a tracker that drifted.
 //
 // The LCM thread only stores the newest frame and queues commands; a worker thread decodes
 // and tracks. When the worker falls behind, older frames are replaced by newer ones and
@@ -24,6 +26,7 @@
 #include <string>
 #include <thread>
 
+#include "air/track/landing/pad_pose.hpp"
 #include "air/track/landing/target_pose.hpp"
 #include "air/track/tracker.hpp"
 #include "common/bus/bus.hpp"
@@ -31,6 +34,10 @@
 #include "common/util/config.hpp"
 
 namespace aerie::track {
+
+// What TARGET_POSE is computed from: the tracker's box and a known size (target_pose.hpp), or
+// the corners of a square pad of side target.width_m refined in the box (pad_pose.hpp).
+enum class TargetShape { Box, Square };
 
 struct NodeOptions {
   std::string camera_channel = "CAM_LEFT";
@@ -46,6 +53,10 @@ struct NodeOptions {
   int init_from_gt = -1;  // >= 0: after this many frames, initialise on the GT_TRACK box
   std::string target_name = "target";
   TargetGeometry target;  // width/height 0: no TARGET_POSE
+  TargetShape target_shape = TargetShape::Box;
+  double pad_border = PadGeometry{}.border;  // square: white border of the pad, fraction of its side
+  double search_margin = 0.5;  // square: the pad is searched in the box grown by this x its size per side
+  double reseed_iou = 0.5;     // square: re-initialise the tracker on the pad when their IoU is below (0 = never)
   std::optional<camera::CameraModel> camera;  // intrinsics (stereo messages bring their own)
 };
 
@@ -79,8 +90,9 @@ class TrackNode {
   void run();
   void execute(const aerie::track_cmd_t& cmd);
   void process(const Frame& frame);
+  std::optional<PadObservation> refine(const TrackState& s);
   void start_tracker(const std::string& name, const util::Config& params, const cv::Rect2d& box);
-  void publish(const Frame& frame, const TrackState* state, double ms);
+  void publish(const Frame& frame, const TrackState* state, double ms, const PadObservation* pad = nullptr);
   void count(const std::string& name, int64_t n = 1);
   void fail(const std::string& message);
 
@@ -107,6 +119,7 @@ class TrackNode {
   cv::Mat last_frame_;
   std::optional<camera::CameraModel> last_camera_;
   cv::Rect2d last_box_;
+  cv::Rect2d last_pad_box_;  // of the last refined pad (empty: none since the last INIT)
   int64_t frames_seen_ = 0, seq_ = 0, pose_seq_ = 0;
   bool gt_init_done_ = false;
   std::thread worker_;
