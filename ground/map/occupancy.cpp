@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <stdexcept>
 
 #include "ground/map/key_ray.hpp"
@@ -430,7 +431,27 @@ void OccupancyMap::save(const std::string& path) const {
   }
 }
 
+namespace {
+// liboctomap's readers print "Reading binary octree type ..." to std::cerr on every call (the
+// Debian library is built with its debug output on); a map message a second would flood
+// the nodes' logs. Errors still reach the caller as exceptions below.
+class QuietCerr {
+ public:
+  QuietCerr() : saved_(std::cerr.rdbuf(nullptr)) {}
+  ~QuietCerr() {
+    std::cerr.rdbuf(saved_);
+    std::cerr.clear();  // writes to the null buffer set badbit
+  }
+  QuietCerr(const QuietCerr&) = delete;
+  QuietCerr& operator=(const QuietCerr&) = delete;
+
+ private:
+  std::streambuf* saved_;
+};
+}  // namespace
+
 std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary) {
+  const QuietCerr quiet;
   if (binary) {
     auto tree = std::make_unique<octomap::OcTree>(0.1);  // readBinary sets the resolution it reads
     if (!tree->readBinary(in)) throw std::invalid_argument("not an OctoMap binary (.bt) tree");
