@@ -284,6 +284,16 @@ void StereoRenderer::project_helipad(const geometry::SE3& T_world_left, StereoFr
 
 StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
                                    const std::vector<geometry::SE3>& blur_poses) const {
+  return render_views(T_world_left, utime, seq, blur_poses, true);
+}
+
+StereoFrame StereoRenderer::render_mono(const geometry::SE3& T_world_cam, int64_t utime, int64_t seq,
+                                        const std::vector<geometry::SE3>& blur_poses) const {
+  return render_views(T_world_cam, utime, seq, blur_poses, false);
+}
+
+StereoFrame StereoRenderer::render_views(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
+                                         const std::vector<geometry::SE3>& blur_poses, bool with_right) const {
   StereoFrame f;
   f.utime = utime;
   f.seq = seq;
@@ -292,21 +302,22 @@ StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t ut
   const geometry::SE3 T_left_right(Eigen::Quaterniond::Identity(), Eigen::Vector3d(rig_.baseline, 0, 0));
   if (blur_poses.empty()) {
     render_view(T_world_left, rad_left, &f.depth);
-    render_view(T_world_left * T_left_right, rad_right, nullptr);
+    if (with_right) render_view(T_world_left * T_left_right, rad_right, nullptr);
   } else {
     // Motion blur: the sensor integrates the radiance over the exposure.
     render_view(T_world_left, rad_left, &f.depth);
     rad_left.setTo(0);
-    rad_right = cv::Mat::zeros(rad_left.size(), rad_left.type());
+    if (with_right) rad_right = cv::Mat::zeros(rad_left.size(), rad_left.type());
     cv::Mat l, r;
     for (const auto& T : blur_poses) {
       render_view(T, l, nullptr);
-      render_view(T * T_left_right, r, nullptr);
       rad_left += l;
+      if (!with_right) continue;
+      render_view(T * T_left_right, r, nullptr);
       rad_right += r;
     }
     rad_left /= static_cast<double>(blur_poses.size());
-    rad_right /= static_cast<double>(blur_poses.size());
+    if (with_right) rad_right /= static_cast<double>(blur_poses.size());
   }
 
   // Photometry: exposure, slow illumination change, right camera gain, noise.
@@ -324,7 +335,7 @@ StereoFrame StereoRenderer::render(const geometry::SE3& T_world_left, int64_t ut
     rad.convertTo(out, type, g);
   };
   finish(rad_left, gain, 0, f.left);
-  finish(rad_right, gain * rig_.right_gain, 1, f.right);
+  if (with_right) finish(rad_right, gain * rig_.right_gain, 1, f.right);
   if (rig_.disparity) {
     f.disparity.create(f.depth.size(), CV_32F);
     const float fb = static_cast<float>(K_.fx * rig_.baseline);

@@ -84,6 +84,10 @@ class StereoRenderer {
   // depth and ground truth stay those of T_world_left.
   StereoFrame render(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
                      const std::vector<geometry::SE3>& blur_poses = {}) const;
+  // The left view alone (a mono camera with this rig's intrinsics and photometry); right
+  // stays empty.
+  StereoFrame render_mono(const geometry::SE3& T_world_cam, int64_t utime, int64_t seq,
+                          const std::vector<geometry::SE3>& blur_poses = {}) const;
 
   // One view into a float radiance image (0..255 scale, before gain, noise and
   // quantisation) and optionally its depth; the building block of render().
@@ -93,6 +97,9 @@ class StereoRenderer {
   void project_helipad(const geometry::SE3& T_world_left, StereoFrame& frame) const;
 
  private:
+  StereoFrame render_views(const geometry::SE3& T_world_left, int64_t utime, int64_t seq,
+                           const std::vector<geometry::SE3>& blur_poses, bool with_right) const;
+
   World world_;
   RigConfig rig_;
   Intrinsics K_;

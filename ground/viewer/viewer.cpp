@@ -57,6 +57,7 @@ void Viewer::add_default_renderers() {
   add(std::make_unique<CameraRenderer>(options_.image_channel));
   add(std::make_unique<TrackOverlay>());
   add(std::make_unique<GtBoxOverlay>());
+  add(std::make_unique<PilotOverlay>());
   add(std::make_unique<GridRenderer>());
   add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false));
   add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true));

@@ -2,6 +2,7 @@
 
 #include <aerie/stereo_image_t.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 
@@ -73,6 +74,39 @@ void TrackOverlay::draw_image(cv::Mat& canvas) {
                 t.status == aerie::track_t::LOST ? " LOST" : "");
   const cv::Point anchor(poly[0].x, std::max(12, poly[0].y - 6));
   cv::putText(canvas, label, anchor, cv::FONT_HERSHEY_SIMPLEX, 0.45, color, 1, cv::LINE_AA);
+}
+
+PilotOverlay::PilotOverlay(std::string channel) : Renderer("pilot"), channel_(std::move(channel)) {}
+
+void PilotOverlay::subscribe(bus::Bus& bus) {
+  bus.subscribe<aerie::pilot_state_t>(channel_, [this](const aerie::pilot_state_t& m, const bus::ReceiveInfo&) { state_.set(m); });
+}
+
+bool PilotOverlay::update() {
+  aerie::pilot_state_t s;
+  if (!state_.take_if_newer(seen_, s)) return false;
+  current_ = std::move(s);
+  return true;
+}
+
+std::string PilotOverlay::banner(const aerie::pilot_state_t& s) {
+  char text[160];
+  if (s.target_valid)
+    std::snprintf(text, sizeof text, "%s  h %.2f m  off %.2f m  yaw %+.1f deg  losses %d", s.state_name.c_str(),
+                  s.height_m, std::hypot(s.target_body[0], s.target_body[1]), s.target_yaw_error_deg, s.losses);
+  else
+    std::snprintf(text, sizeof text, "%s  (%s)  losses %d", s.state_name.c_str(), s.reason.c_str(), s.losses);
+  return text;
+}
+
+void PilotOverlay::draw_image(cv::Mat& canvas) {
+  if (!current_) return;
+  const auto& s = *current_;
+  const bool alarm = s.state == aerie::pilot_state_t::HOLD || s.state == aerie::pilot_state_t::ABORT ||
+                     s.state == aerie::pilot_state_t::ABORTED;
+  const cv::Scalar color = alarm ? cv::Scalar(0, 128, 255) : cv::Scalar(255, 255, 255);
+  cv::rectangle(canvas, cv::Rect(0, canvas.rows - 18, canvas.cols, 18), cv::Scalar(0, 0, 0), cv::FILLED);
+  cv::putText(canvas, banner(s), cv::Point(4, canvas.rows - 5), cv::FONT_HERSHEY_SIMPLEX, 0.4, color, 1, cv::LINE_AA);
 }
 
 GtBoxOverlay::GtBoxOverlay(std::string channel) : Renderer("gt-box"), channel_(std::move(channel)) {}

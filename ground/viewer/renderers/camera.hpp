@@ -2,6 +2,7 @@
 // Renderers of the camera image pane: the camera image itself (mono channel or the left
 // image of a stereo pair), the tracker overlay and the ground-truth box.
 #include <aerie/gt_box_t.hpp>
+#include <aerie/pilot_state_t.hpp>
 #include <aerie/track_t.hpp>
 
 #include "ground/viewer/latest.hpp"
@@ -44,6 +45,24 @@ class TrackOverlay : public Renderer {
   Latest<aerie::track_t> track_;
   uint64_t seen_ = 0;
   std::optional<aerie::track_t> current_;
+};
+
+// PILOT_STATE: the flight manager's state, why it is there, and what it sees of the target
+// (height, horizontal offset, yaw error, losses) as a banner over the camera image; HOLD and
+// the abort states in orange.
+class PilotOverlay : public Renderer {
+ public:
+  explicit PilotOverlay(std::string channel = "PILOT_STATE");
+  void subscribe(bus::Bus& bus) override;
+  bool update() override;
+  void draw_image(cv::Mat& canvas) override;
+  static std::string banner(const aerie::pilot_state_t& s);
+
+ private:
+  std::string channel_;
+  Latest<aerie::pilot_state_t> state_;
+  uint64_t seen_ = 0;
+  std::optional<aerie::pilot_state_t> current_;
 };
 
 // GT_TRACK: the ground-truth target box when a source publishes one.

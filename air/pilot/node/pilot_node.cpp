@@ -1,0 +1,130 @@
+#include "air/pilot/node/pilot_node.hpp"
+
+#include <aerie/imu_t.hpp>
+#include <aerie/pilot_cmd_t.hpp>
+#include <aerie/pilot_state_t.hpp>
+#include <aerie/target_pose_t.hpp>
+#include <aerie/track_t.hpp>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+namespace aerie::pilot {
+
+PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options)
+    : bus_(bus), pilot_(std::move(config)), opt_(std::move(options)) {
+  // Every handler turns a refused input into a counted error; the pilot keeps its state.
+  auto guarded = [this](const std::string& what, auto&& fn) {
+    try {
+      fn();
+    } catch (const std::exception& e) {
+      count(what + "_refused");
+      last_error_ = what + ": " + e.what();
+      spdlog::warn("{}", last_error_);
+    }
+  };
+  bus_.subscribe<aerie::target_pose_t>(opt_.target_channel, [this, guarded](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
+    guarded(opt_.target_channel, [&] {
+      pilot_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.yaw});
+      count("targets");
+    });
+  });
+  bus_.subscribe<aerie::track_t>(opt_.track_channel, [this, guarded](const aerie::track_t& m, const bus::ReceiveInfo&) {
+    guarded(opt_.track_channel, [&] {
+      if (m.status < 0 || m.status > aerie::track_t::REDETECTED)
+        throw std::invalid_argument("unknown track status " + std::to_string(m.status));
+      count("tracks");
+      publish(pilot_.on_track(m.utime, static_cast<TrackStatus>(m.status)));
+    });
+  });
+  bus_.subscribe<aerie::imu_t>(opt_.imu_channel, [this, guarded](const aerie::imu_t& m, const bus::ReceiveInfo&) {
+    guarded(opt_.imu_channel, [&] {
+      if (m.orientation_valid)
+        pilot_.on_attitude(m.utime, Eigen::Quaterniond(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]));
+      if (const auto c = pilot_.on_clock(m.utime)) publish(*c);
+    });
+  }, 1000);  // 200 Hz: a deep queue so that a burst is not dropped
+  bus_.subscribe<aerie::pilot_cmd_t>(opt_.operator_channel, [this](const aerie::pilot_cmd_t& m, const bus::ReceiveInfo&) {
+    if (m.command < aerie::pilot_cmd_t::START || m.command > aerie::pilot_cmd_t::RESUME) {
+      count("operator_refused");
+      last_error_ = opt_.operator_channel + ": unknown command " + std::to_string(m.command);
+      spdlog::warn("{}", last_error_);
+      return;
+    }
+    std::string why;
+    if (pilot_.on_operator(static_cast<Pilot::Operator>(m.command), m.utime, &why)) {
+      count("operator_accepted");
+      spdlog::info("operator command from '{}' accepted: {} ({})", m.source, state_name(pilot_.state()),
+                   pilot_.status().reason);
+    } else {
+      count("operator_refused");
+      last_error_ = opt_.operator_channel + ": " + why;
+      spdlog::warn("{}", last_error_);
+    }
+  });
+}
+
+void PilotNode::publish(const Command& c) {
+  const PilotStatus& s = pilot_.status();
+  if (s.state != last_state_) {
+    spdlog::info("{} -> {}: {}", state_name(last_state_), state_name(s.state), s.reason);
+    last_state_ = s.state;
+    count("transitions");
+  }
+  aerie::control_cmd_t m{};
+  m.utime = c.utime;
+  m.seq = cmd_seq_++;
+  switch (c.mode) {
+    case Command::Mode::Hover: m.mode = aerie::control_cmd_t::HOVER; break;
+    case Command::Mode::Velocity: m.mode = aerie::control_cmd_t::ACTIVE; break;
+    case Command::Mode::Takeoff: m.mode = aerie::control_cmd_t::TAKEOFF; break;
+    case Command::Mode::Land: m.mode = aerie::control_cmd_t::LAND; break;
+  }
+  m.controller_id = "pilot-" + pilot_.config().controller;
+  for (int i = 0; i < 3; ++i) m.velocity_body[i] = static_cast<float>(c.velocity[i]);
+  m.yaw_rate_deg_s = static_cast<float>(c.yaw_rate_deg_s);
+  m.heading_error_deg = std::isfinite(s.yaw_error_deg) ? static_cast<float>(s.yaw_error_deg) : 0.f;
+  bus_.publish(opt_.command_channel, m);
+  count("commands");
+
+  aerie::pilot_state_t p{};
+  p.utime = c.utime;
+  p.seq = state_seq_++;
+  p.state = static_cast<int8_t>(s.state);
+  p.state_name = state_name(s.state);
+  p.reason = s.reason;
+  p.time_in_state_s = s.time_in_state_s;
+  p.target_valid = s.target_valid;
+  for (int i = 0; i < 3; ++i) {
+    p.target_body[i] = s.target_level[i];
+    p.command_velocity[i] = m.velocity_body[i];
+  }
+  p.target_yaw_error_deg = s.yaw_error_deg;
+  p.height_m = s.height_m;
+  p.command_yaw_rate_deg_s = m.yaw_rate_deg_s;
+  p.losses = s.losses;
+  p.reacquisitions = s.reacquisitions;
+  p.controller = pilot_.config().controller;
+  bus_.publish(opt_.state_channel, p);
+}
+
+int64_t PilotNode::counter(const std::string& name) const {
+  const auto it = counters_.find(name);
+  return it == counters_.end() ? 0 : it->second;
+}
+
+void PilotNode::report(bus::StatusReporter& status) const {
+  for (const auto& [k, v] : counters_) status.set(k, v);
+  const PilotStatus& s = pilot_.status();
+  status.set("losses", s.losses);
+  status.set("reacquisitions", s.reacquisitions);
+  const std::string msg = std::string(state_name(s.state)) + ": " + s.reason;
+  if (s.state == State::Hold || s.state == State::Abort || s.state == State::Aborted)
+    status.warn(msg);
+  else if (!last_error_.empty())
+    status.warn(msg + " (last refused input: " + last_error_ + ")");
+  else
+    status.ok(msg);
+}
+
+}  // namespace aerie::pilot

@@ -1,0 +1,49 @@
+#pragma once
+// aerie-pilot as a class: TARGET_POSE (aerie.target_pose_t), TRACK (aerie.track_t), IMU
+// (aerie.imu_t) and PILOT_CMD (aerie.pilot_cmd_t) in; CTRL_CMD (aerie.control_cmd_t) and
+// PILOT_STATE (aerie.pilot_state_t) out. One command per TRACK message, with its utime
+// (the frame's answer in lock-step); while the tracker is silent, the IMU clock ticks
+// the pilot (Pilot::on_clock). Bad messages are counted and dropped; the state machine
+// never sees them.
+#include <aerie/control_cmd_t.hpp>
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "air/pilot/pilot.hpp"
+#include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
+
+namespace aerie::pilot {
+
+struct PilotNodeOptions {
+  std::string target_channel = "TARGET_POSE";
+  std::string track_channel = "TRACK";
+  std::string imu_channel = "IMU";
+  std::string operator_channel = "PILOT_CMD";
+  std::string command_channel = "CTRL_CMD";
+  std::string state_channel = "PILOT_STATE";
+};
+
+class PilotNode {
+ public:
+  PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options = {});
+  void report(bus::StatusReporter& status) const;
+  const Pilot& pilot() const { return pilot_; }
+  int64_t counter(const std::string& name) const;
+
+ private:
+  void publish(const Command& c);
+  void count(const std::string& name) { ++counters_[name]; }
+
+  bus::Bus& bus_;
+  Pilot pilot_;
+  PilotNodeOptions opt_;
+  std::map<std::string, int64_t> counters_;
+  std::string last_error_;
+  State last_state_ = State::Idle;
+  int64_t cmd_seq_ = 0, state_seq_ = 0;
+};
+
+}  // namespace aerie::pilot

@@ -1,0 +1,277 @@
+#include "air/pilot/pilot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace aerie::pilot {
+
+namespace {
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Wraps degrees to (-90, 90]: the pad's H looks the same after half a turn.
+double wrap_half_turn_deg(double a) {
+  a = std::remainder(a, 180.0);
+  return a <= -90.0 ? a + 180.0 : a;
+}
+
+bool airborne(State s) {
+  return s != State::Idle && s != State::Landed && s != State::Touchdown;
+}
+}  // namespace
+
+const char* state_name(State s) {
+  static constexpr const char* kNames[] = {"IDLE",    "TAKEOFF",   "SURVEY", "ACQUIRE", "APPROACH", "DESCEND",
+                                           "TOUCHDOWN", "LANDED", "HOLD",    "ABORT",    "ABORTED"};
+  return kNames[static_cast<int>(s)];
+}
+
+void PilotConfig::validate() const {
+  auto need = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("pilot config: ") + what);
+  };
+  need(controller == "fuzzy" || controller == "pid", "controller must be fuzzy or pid");
+  need(takeoff_time_s > 0 && takeoff_min_s >= 0 && acquire_timeout_s > 0 && hold_timeout_s > 0 && touchdown_time_s > 0,
+       "takeoff_time_s, acquire_timeout_s, hold.timeout_s and descent.touchdown_time_s must be > 0");
+  need(survey_speed_m_s > 0 && descent_speed_m_s > 0 && abort_climb_m_s > 0 && hold_climb_m_s >= 0,
+       "survey, descent and abort speeds must be > 0, the hold climb >= 0");
+  need(approach_height_m > touchdown_height_m && touchdown_height_m > 0,
+       "approach.height_m must exceed descent.touchdown_height_m > 0");
+  need(approach_tolerance_m > 0 && yaw_tolerance_deg > 0 && height_tolerance_m > 0 && descent_gate_m > 0,
+       "tolerances and descent.gate_m must be > 0");
+  need(settle_frames >= 1 && loss_frames >= 1, "settle_frames and loss_frames must be >= 1");
+  need(stale_timeout_s > 0 && control_period_s > 0 && abort_climb_s >= 0 && hold_climb_max_s >= 0,
+       "stale_timeout_s and control_period_s must be > 0");
+  for (const auto& leg : survey_legs) need(leg.allFinite(), "survey legs must be finite");
+}
+
+Pilot::Pilot(PilotConfig config) : cfg_(std::move(config)) {
+  cfg_.validate();
+  forward_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.forward);
+  left_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.left);
+  up_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.up);
+  yaw_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.yaw);
+  // Camera optical axes in the body frame: x right (-y_body), z tilted down by the pitch.
+  const double p = cfg_.camera_pitch_deg * kDeg;
+  const Eigen::Vector3d x_c(0, -1, 0), z_c(std::cos(p), 0, -std::sin(p));
+  R_body_cam_.col(0) = x_c;
+  R_body_cam_.col(1) = z_c.cross(x_c);
+  R_body_cam_.col(2) = z_c;
+  status_.state = State::Idle;
+}
+
+void Pilot::on_attitude(int64_t, const Eigen::Quaterniond& q) {
+  if (!q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3)
+    throw std::invalid_argument("attitude is not a finite unit quaternion");
+  attitude_ = q;
+}
+
+void Pilot::on_target(const TargetObservation& t) {
+  if (!t.position_cam.allFinite() || !std::isfinite(t.yaw_cam) || !(t.position_cam.z() > 0))
+    throw std::invalid_argument("target pose is not finite or not in front of the camera");
+  target_ = t;
+}
+
+void Pilot::enter(State s, int64_t utime, const std::string& reason) {
+  if (s == State::Approach && status_.state != State::Hold) reset_controllers();
+  status_.state = s;
+  status_.reason = reason;
+  state_since_ = utime;
+  settled_run_ = 0;
+}
+
+void Pilot::reset_controllers() {
+  forward_->reset();
+  left_->reset();
+  up_->reset();
+  yaw_->reset();
+}
+
+Command Pilot::hover(int64_t utime) const {
+  Command c;
+  c.utime = utime;
+  c.mode = Command::Mode::Velocity;  // zero velocity: the autopilot holds position and height
+  return c;
+}
+
+Command Pilot::steer(int64_t utime, double t, const Eigen::Vector3d& target, double yaw_error_deg, double vz) {
+  Command c = hover(utime);
+  c.velocity = {forward_->update(t, target.x()), left_->update(t, target.y()), vz};
+  c.yaw_rate_deg_s = yaw_->update(t, yaw_error_deg);
+  return c;
+}
+
+Command Pilot::on_track(int64_t utime, TrackStatus status) {
+  last_track_ = utime;
+  return tick(utime, true, status);
+}
+
+std::optional<Command> Pilot::on_clock(int64_t utime) {
+  if (last_track_ < 0) last_track_ = utime;  // the silence starts with the first message
+  if (utime - last_track_ < static_cast<int64_t>(cfg_.stale_timeout_s * 1e6)) return std::nullopt;
+  if (last_tick_ >= 0 && utime - last_tick_ < static_cast<int64_t>(cfg_.control_period_s * 1e6)) return std::nullopt;
+  if (status_.state == State::Approach || status_.state == State::Descend) {
+    resume_state_ = status_.state;
+    enter(State::Hold, utime, "no tracker result for " + std::to_string((utime - last_track_) * 1e-6) + " s (stale)");
+  }
+  return tick(utime, false, TrackStatus::Idle);
+}
+
+bool Pilot::on_operator(Operator cmd, int64_t utime, std::string* why) {
+  auto refuse = [&](const std::string& w) {
+    if (why) *why = w + " in state " + state_name(status_.state);
+    return false;
+  };
+  switch (cmd) {
+    case Operator::Start:
+      if (status_.state != State::Idle) return refuse("START");
+      started_ = true;
+      return true;
+    case Operator::Abort:
+      if (!airborne(status_.state) || status_.state == State::Aborted) return refuse("ABORT");
+      enter(State::Abort, utime, "operator ABORT");
+      return true;
+    case Operator::Land:
+      if (!airborne(status_.state)) return refuse("LAND");
+      enter(State::Touchdown, utime, "operator LAND");
+      return true;
+    case Operator::Resume:
+      if (status_.state != State::Hold && status_.state != State::Aborted) return refuse("RESUME");
+      enter(State::Acquire, utime, "operator RESUME");
+      return true;
+  }
+  return refuse("unknown command");
+}
+
+Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
+  last_tick_ = utime;
+  const double t = utime * 1e-6;
+  // The target of this frame, in the levelled heading frame.
+  const bool tracked = track == TrackStatus::Tracking || track == TrackStatus::Redetected;
+  const bool have = fresh_track && tracked && target_ && target_->utime == utime;
+  if (fresh_track) lost_run_ = have ? 0 : lost_run_ + 1;
+  status_.target_valid = have;
+  Eigen::Vector3d p = Eigen::Vector3d::Constant(std::nan(""));
+  double yaw_err = std::nan(""), height = std::nan("");
+  if (have) {
+    // R = Rz(yaw) * tilt (ZYX): remove the yaw to keep roll and pitch.
+    const Eigen::Matrix3d R = attitude_.toRotationMatrix();
+    const Eigen::Matrix3d tilt = Eigen::AngleAxisd(-std::atan2(R(1, 0), R(0, 0)), Eigen::Vector3d::UnitZ()) * R;
+    p = tilt * (R_body_cam_ * target_->position_cam);
+    height = -p.z();
+    // Body forward is image "up" (-y) for a camera pitched down: the pad's axis should sit
+    // at -90 deg in the image; the rest is the turn still needed (clockwise positive).
+    yaw_err = wrap_half_turn_deg(target_->yaw_cam / kDeg + 90.0);
+  }
+  status_.target_level = p;
+  status_.yaw_error_deg = yaw_err;
+  status_.height_m = height;
+
+  auto time_in_state = [&] { return (utime - state_since_) * 1e-6; };
+  auto lost = [&](State resume) {
+    if (lost_run_ < cfg_.loss_frames) return false;
+    resume_state_ = resume;
+    ++status_.losses;
+    enter(State::Hold, utime, "target lost for " + std::to_string(lost_run_) + " frames");
+    return true;
+  };
+
+  Command c = hover(utime);
+  switch (status_.state) {
+    case State::Idle:
+      if (!cfg_.wait_for_start || started_) {
+        enter(State::Takeoff, utime, cfg_.wait_for_start ? "operator START" : "mission start");
+        c.mode = Command::Mode::Takeoff;
+      }
+      break;
+    case State::Takeoff:
+      c.mode = Command::Mode::Takeoff;
+      if (have && time_in_state() >= cfg_.takeoff_min_s)
+        enter(State::Approach, utime, "target acquired during the take-off");
+      else if (time_in_state() >= cfg_.takeoff_time_s)
+        enter(cfg_.survey_legs.empty() ? State::Acquire : State::Survey, utime, "take-off done");
+      break;
+    case State::Survey: {
+      if (have) {
+        enter(State::Approach, utime, "target acquired during the survey");
+        break;
+      }
+      // The legs are dead-reckoned: each is flown at the survey speed for its length.
+      double elapsed = time_in_state();
+      bool on_leg = false;
+      for (const auto& leg : cfg_.survey_legs) {
+        const double duration = leg.norm() / cfg_.survey_speed_m_s;
+        if (elapsed < duration) {
+          c.velocity.head<2>() = leg.normalized() * cfg_.survey_speed_m_s;
+          on_leg = true;
+          break;
+        }
+        elapsed -= duration;
+      }
+      if (!on_leg) enter(State::Acquire, utime, "survey done without the target");
+      break;
+    }
+    case State::Acquire:
+      if (have)
+        enter(State::Approach, utime, "target acquired");
+      else if (time_in_state() >= cfg_.acquire_timeout_s)
+        enter(State::Abort, utime, "no target within " + std::to_string(cfg_.acquire_timeout_s) + " s");
+      break;
+    case State::Approach:
+      if (!have) {
+        lost(State::Approach);
+        break;
+      }
+      c = steer(utime, t, p, yaw_err, up_->update(t, cfg_.approach_height_m - height));
+      settled_run_ = p.head<2>().norm() < cfg_.approach_tolerance_m && std::abs(yaw_err) < cfg_.yaw_tolerance_deg &&
+                             std::abs(height - cfg_.approach_height_m) < cfg_.height_tolerance_m
+                         ? settled_run_ + 1
+                         : 0;
+      if (settled_run_ >= cfg_.settle_frames) enter(State::Descend, utime, "centred and aligned over the target");
+      break;
+    case State::Descend: {
+      if (!have) {
+        lost(State::Descend);
+        break;
+      }
+      if (height < cfg_.touchdown_height_m) {
+        enter(State::Touchdown, utime, "below the touchdown height");
+        c.mode = Command::Mode::Land;
+        break;
+      }
+      const double gate = std::clamp(1.0 - p.head<2>().norm() / cfg_.descent_gate_m, 0.0, 1.0);
+      c = steer(utime, t, p, yaw_err, -cfg_.descent_speed_m_s * gate);
+      break;
+    }
+    case State::Touchdown:
+      c.mode = Command::Mode::Land;
+      if (time_in_state() >= cfg_.touchdown_time_s) enter(State::Landed, utime, "touchdown");
+      break;
+    case State::Landed:
+      c.mode = Command::Mode::Land;
+      break;
+    case State::Hold:
+      if (have) {
+        ++status_.reacquisitions;
+        enter(resume_state_, utime, "target re-acquired");
+        break;
+      }
+      if (time_in_state() >= cfg_.hold_timeout_s) {
+        enter(State::Abort, utime, "target not re-acquired within " + std::to_string(cfg_.hold_timeout_s) + " s");
+        break;
+      }
+      if (time_in_state() < cfg_.hold_climb_max_s) c.velocity.z() = cfg_.hold_climb_m_s;
+      break;
+    case State::Abort:
+      c.velocity.z() = cfg_.abort_climb_m_s;
+      if (time_in_state() >= cfg_.abort_climb_s) enter(State::Aborted, utime, status_.reason);
+      break;
+    case State::Aborted:
+      break;
+  }
+  status_.time_in_state_s = time_in_state();
+  return last_ = c;
+}
+
+}  // namespace aerie::pilot

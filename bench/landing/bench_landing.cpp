@@ -1,0 +1,200 @@
+// aerie-bench-landing: seeded autonomous landings in lock-step, one row per run.
+//   aerie-bench-landing --runs N --seed S --tracker NAME --wind M_S --vibration on|off
+//                       --world room|field --out DIR
+// Each run builds the flight simulator (config/sim/landing_<world>.yaml), the tracking node
+// (config/track_landing.yaml) and the pilot (config/pilot.yaml) on one in-process LCM bus
+// (memq://) and flies until the simulator reports the flight over: the same node code as
+// aerie-flightsim, aerie-track and aerie-pilot, in lock-step, so a row depends on its seed
+// alone. Lists (--tracker a,b --wind 0,1,2 ...) run every combination. Writes
+// DIR/landings.csv, DIR/descent.csv (TARGET_POSE error per frame of the descent) and prints
+// one summary line per configuration; DIR/*.png when bench/landing/plot_landing.py runs.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <numeric>
+#include <opencv2/core.hpp>
+#include <sstream>
+#include <thread>
+
+#include "air/pilot/pilot_config.hpp"
+#include "air/track/factory.hpp"
+#include "common/sim/flight/flight_config.hpp"
+#include "tools/landing/landing_run.hpp"
+
+using namespace aerie;
+
+namespace {
+
+struct Setup {
+  std::string tracker, world, controller;
+  double wind = 0;
+  bool vibration = false;
+};
+
+struct Files {
+  std::string sim_dir, track, pilot;
+};
+
+landing::RunResult fly(const Setup& setup, uint64_t seed, const Files& files) {
+  landing::RunConfig rc;
+  rc.sim = sim::load_flight_config(util::Config::load(files.sim_dir + "/landing_" + setup.world + ".yaml"));
+  rc.sim.seed = seed;
+  rc.sim.wind.mean_m_s = setup.wind;
+  rc.sim.vibration.enabled = setup.vibration;
+  rc.track = track::node_options(util::Config::load(files.track));
+  rc.track.tracker = setup.tracker;
+  rc.track.seed = seed;
+  YAML::Node pilot_yaml = YAML::LoadFile(files.pilot);
+  pilot_yaml["controller"] = setup.controller;
+  YAML::Emitter out;
+  out << pilot_yaml;
+  rc.pilot = pilot::load_pilot_config(util::Config::parse(out.c_str(), files.pilot));
+  return landing::fly(rc);
+}
+
+double mean(const std::vector<double>& v) {
+  return v.empty() ? std::nan("") : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(std::min<double>(static_cast<double>(v.size()) - 1, std::ceil(p * static_cast<double>(v.size())) - 1))];
+}
+
+std::string summary(const Setup& s, const std::vector<landing::RunResult>& runs) {
+  int ok = 0;
+  std::vector<double> err, time, losses;
+  double rm[4] = {0, 0, 0, 0};
+  size_t n_desc = 0;
+  double wall = 0, sim_s = 0;
+  for (const auto& r : runs) {
+    ok += r.score.success;
+    if (r.outcome.landed) {
+      err.push_back(r.score.touchdown_error_m);
+      time.push_back(r.score.time_s);
+    }
+    losses.push_back(r.losses);
+    for (const auto& d : r.descent) {
+      rm[0] += d.ex * d.ex;
+      rm[1] += d.ey * d.ey;
+      rm[2] += d.ez * d.ez;
+      rm[3] += d.eyaw_deg * d.eyaw_deg;
+    }
+    n_desc += r.descent.size();
+    wall += r.wall_s;
+    sim_s += r.sim_s;
+  }
+  for (double& v : rm) v = n_desc ? std::sqrt(v / static_cast<double>(n_desc)) : std::nan("");
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "%-11s %-5s %-5s wind %.0f vib %-3s: %d/%zu landed in bounds (%.1f %%), touchdown error mean %.3f m p95 "
+                "%.3f m, time %.1f s, losses %.2f/run, TARGET_POSE RMSE x %.1f y %.1f z %.1f cm yaw %.2f deg, %.2f s "
+                "wall per simulated s",
+                s.tracker.c_str(), s.controller.c_str(), s.world.c_str(), s.wind, s.vibration ? "on" : "off", ok,
+                runs.size(), 100.0 * ok / static_cast<double>(runs.size()), mean(err), percentile(err, 0.95),
+                mean(time), mean(losses), 100 * rm[0], 100 * rm[1], 100 * rm[2], rm[3], wall / sim_s);
+  return line;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"aerie-bench-landing: seeded autonomous landings in lock-step (CSV, summary, plots)"};
+  int runs = 50, jobs = 1;
+  uint64_t seed = 1;
+  std::vector<std::string> trackers{"amcmr-ct"}, worlds{"room"}, vibrations{"on"}, controllers{"fuzzy"};
+  std::vector<double> winds{0.0};
+  std::string out_dir = "bench-landing";
+  Files files{"config/sim", "config/track_landing.yaml", "config/pilot.yaml"};
+  bool plots = true;
+  std::string log_level = "warn";
+  app.add_option("--runs", runs, "landings per configuration")->check(CLI::PositiveNumber);
+  app.add_option("--seed", seed, "seed of the first run (run i uses seed + i)");
+  app.add_option("--tracker", trackers, "trackers (comma-separated): ipsl-mr, amcmr-ct, am3, dcf, opencv-csrt, ...")
+      ->delimiter(',');
+  app.add_option("--wind", winds, "mean wind speeds in m/s (comma-separated; gusts 0.3 x that)")->delimiter(',');
+  app.add_option("--vibration", vibrations, "camera vibration: on, off or on,off")->delimiter(',')
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--world", worlds, "room, field or room,field")->delimiter(',')->check(CLI::IsMember({"room", "field"}));
+  app.add_option("--controller", controllers, "landing controller: fuzzy, pid or fuzzy,pid")->delimiter(',')
+      ->check(CLI::IsMember({"fuzzy", "pid"}));
+  app.add_option("--out", out_dir, "output folder (landings.csv, descent.csv, plots)");
+  app.add_option("--jobs", jobs, "landings flown in parallel (threads)")->check(CLI::Range(1, 64));
+  app.add_option("--sim-config-dir", files.sim_dir, "folder of landing_room.yaml and landing_field.yaml");
+  app.add_option("--track-config", files.track, "aerie-track configuration");
+  app.add_option("--pilot-config", files.pilot, "aerie-pilot configuration");
+  app.add_flag("!--no-plots", plots, "do not run bench/landing/plot_landing.py");
+  app.add_option("--log-level", log_level, "the nodes' log level (info shows every pilot transition)");
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(log_level));  // warn: the nodes' transitions would flood the output
+  for (const auto& t : trackers)
+    if (!track::is_known_tracker(t)) {
+      std::fprintf(stderr, "aerie-bench-landing: unknown tracker '%s'\n", t.c_str());
+      return 2;
+    }
+  std::vector<Setup> setups;
+  for (const auto& w : worlds)
+    for (const auto& t : trackers)
+      for (const auto& c : controllers)
+        for (double wind : winds)
+          for (const auto& v : vibrations) setups.push_back({t, w, c, wind, v == "on"});
+  if (jobs > 1) cv::setNumThreads(1);  // one core per landing
+  std::filesystem::create_directories(out_dir);
+  std::ofstream csv(out_dir + "/landings.csv"), desc(out_dir + "/descent.csv");
+  csv << "seed,tracker,world,wind_m_s,vibration,success,touchdown_error_m,yaw_error_deg,time_s,collision,losses,"
+         "reacquisitions,controller,landed,timed_out,final_state,lockstep_timeouts,pose_rmse_x_m,pose_rmse_y_m,"
+         "pose_rmse_z_m,pose_rmse_yaw_deg,sim_s,wall_s\n";
+  desc << "seed,tracker,world,wind_m_s,vibration,controller,t_s,height_m,err_x_m,err_y_m,err_z_m,err_yaw_deg\n";
+  int failures = 0;
+  for (const auto& s : setups) {
+    std::vector<landing::RunResult> results(static_cast<size_t>(runs));
+    std::atomic<int> next{0};
+    std::mutex err_mutex;
+    auto worker = [&] {
+      for (int i = next++; i < runs; i = next++) {
+        try {
+          results[static_cast<size_t>(i)] = fly(s, seed + static_cast<uint64_t>(i), files);
+        } catch (const std::exception& e) {
+          std::lock_guard lk(err_mutex);
+          std::fprintf(stderr, "aerie-bench-landing: run with seed %llu failed: %s\n",
+                       static_cast<unsigned long long>(seed + static_cast<uint64_t>(i)), e.what());
+          ++failures;
+        }
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int j = 0; j < jobs; ++j) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+    if (failures) return 1;
+    for (size_t i = 0; i < results.size(); ++i) {
+      const auto& r = results[i];
+      const uint64_t run_seed = seed + i;
+      const char* vib = s.vibration ? "on" : "off";
+      csv << run_seed << ',' << s.tracker << ',' << s.world << ',' << s.wind << ',' << vib << ',' << r.score.success << ','
+          << r.score.touchdown_error_m << ',' << r.score.yaw_error_deg << ',' << r.score.time_s << ','
+          << r.outcome.collided << ',' << r.losses << ',' << r.reacquisitions << ',' << s.controller << ','
+          << r.outcome.landed << ',' << r.outcome.timed_out
+          << ',' << r.final_state << ',' << r.lockstep_timeouts << ',' << r.rmse(0) << ',' << r.rmse(1) << ','
+          << r.rmse(2) << ',' << r.rmse(3) << ',' << r.sim_s << ',' << r.wall_s << '\n';
+      for (const auto& d : r.descent)
+        desc << run_seed << ',' << s.tracker << ',' << s.world << ',' << s.wind << ',' << vib << ',' << s.controller << ','
+             << d.t << ',' << d.height << ',' << d.ex << ',' << d.ey << ',' << d.ez << ',' << d.eyaw_deg << '\n';
+    }
+    csv.flush();
+    desc.flush();
+    std::printf("%s\n", summary(s, results).c_str());
+    std::fflush(stdout);
+  }
+  if (plots) {
+    const std::string cmd = "/usr/bin/python3 bench/landing/plot_landing.py " + out_dir;
+    if (std::filesystem::exists("bench/landing/plot_landing.py") && std::system(cmd.c_str()) != 0)
+      std::fprintf(stderr, "aerie-bench-landing: plotting failed (%s)\n", cmd.c_str());
+  }
+  return 0;
+}

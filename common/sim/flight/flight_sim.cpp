@@ -1,0 +1,303 @@
+#include "common/sim/flight/flight_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "common/sim/texture.hpp"
+
+namespace aerie::sim {
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+// Wraps an angle to (-pi/2, pi/2]: the helipad's H looks the same after half a turn.
+double wrap_half_turn(double a) {
+  a = std::remainder(a, kPi);
+  return a <= -kPi / 2 ? a + kPi : a;
+}
+}  // namespace
+
+RigConfig FlightSimConfig::down_rig() {
+  RigConfig r;
+  r.width = 376;
+  r.height = 240;
+  r.baseline = 0.01;  // unused by a mono camera (the renderer needs one; it offsets the camera 5 mm)
+  r.hfov_deg = 90.0;
+  r.vfov_deg = 65.0;
+  r.pitch_deg = 90.0;  // optical axis along body -z; image top = forward
+  r.noise_sigma = 2.0;
+  return r;
+}
+
+void FlightSimConfig::validate() const {
+  auto need = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("flight simulator: " + what);
+  };
+  vehicle.validate();
+  imu.validate();
+  need(frame_rate_hz > 0 && frame_rate_hz <= imu.rate_hz, "frame_rate_hz must be in (0, imu.rate_hz]");
+  const double ratio = imu.rate_hz / frame_rate_hz;
+  need(std::abs(ratio - std::round(ratio)) < 1e-9, "imu.rate_hz must be a whole multiple of frame_rate_hz");
+  need(wind.mean_m_s >= 0 && wind.mean_m_s <= 15, "wind.mean_m_s must be in [0, 15]");
+  need(wind.gust_time_constant_s > 0, "wind.gust_time_constant_s must be > 0");
+  need(vibration.amplitude_deg >= 0 && vibration.amplitude_deg <= 10, "vibration.amplitude_deg must be in [0, 10]");
+  need(vibration.frequency_hz > 0, "vibration.frequency_hz must be > 0");
+  need(placement.start_distance_min_m >= 0 && placement.start_distance_max_m >= placement.start_distance_min_m,
+       "placement: need 0 <= start_distance_min_m <= start_distance_max_m");
+  need(placement.exposure_jitter >= 0 && placement.exposure_jitter < 0.9, "placement.exposure_jitter must be in [0, 0.9)");
+  need(max_time_s > 0, "max_time_s must be > 0");
+  need(down_camera.width > 0 && down_camera.height > 0, "down_camera size must be > 0");
+}
+
+FlightSim::FlightSim(const FlightSimConfig& config)
+    : cfg_(config),
+      world_([&] {
+        cfg_.validate();
+        // The world's layout and textures, the pad's place and yaw all come from the seed.
+        WorldConfig w = cfg_.world;
+        w.seed = mix_seed(cfg_.seed, 7000);
+        std::mt19937_64 placement(mix_seed(cfg_.seed, 7001));
+        std::uniform_real_distribution<double> u01(0.0, 1.0);
+        w.helipad_yaw_deg = cfg_.placement.pad_yaw_deg < 0 ? 180.0 * u01(placement) : cfg_.placement.pad_yaw_deg;
+        if (w.kind == "room" && std::isnan(w.helipad_x) && std::isnan(w.helipad_y)) {
+          // Anywhere in the middle half of the room (the field places its car itself).
+          w.helipad_x = (u01(placement) - 0.5) * 0.5 * w.room_x;
+          w.helipad_y = (u01(placement) - 0.5) * 0.5 * w.room_y;
+        }
+        cfg_.world = w;
+        return World::make(w);
+      }()),
+      down_(world_, cfg_.down_camera),
+      forward_(world_, cfg_.stereo_rig),
+      vehicle_(cfg_.vehicle, {}),
+      imu_(cfg_.imu, mix_seed(cfg_.seed, 7002)),
+      rng_(mix_seed(cfg_.seed, 7003)) {
+  // Lighting, image noise.
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double j = cfg_.placement.exposure_jitter;
+  RigConfig down = cfg_.down_camera;
+  down.exposure *= 1.0 - j + 2 * j * u01(rng_);
+  down.noise_seed = mix_seed(cfg_.seed, 7004);
+  RigConfig fwd = cfg_.stereo_rig;
+  fwd.exposure = down.exposure / cfg_.down_camera.exposure * fwd.exposure;
+  fwd.noise_seed = mix_seed(cfg_.seed, 7005);
+  down_ = StereoRenderer(world_, down);
+  forward_ = StereoRenderer(world_, fwd);
+  T_body_down_ = body_to_left(down);
+  T_body_left_ = body_to_left(fwd);
+
+  // Take-off point: on free ground at the drawn distance from the pad, with room to climb.
+  const Helipad& pad = world_.helipad();
+  const double r = cfg_.vehicle.radius_m;
+  MultirotorState start;
+  bool placed = false;
+  for (int attempt = 0; attempt < 500 && !placed; ++attempt) {
+    const double d = cfg_.placement.start_distance_min_m +
+                     (cfg_.placement.start_distance_max_m - cfg_.placement.start_distance_min_m) * u01(rng_);
+    const double phi = 2 * kPi * u01(rng_);
+    Eigen::Vector3d p(pad.center.x() + d * std::cos(phi), pad.center.y() + d * std::sin(phi), 10.0);
+    p.z() = support_height(p);
+    bool free = p.z() <= world_.bounds().min.z() + 1e-9;  // on the ground, not on an object
+    for (double h = 0.2; free && h <= cfg_.vehicle.takeoff_height_m + 0.3; h += 0.1)  // the column it climbs
+      free = world_.signed_distance(p + Eigen::Vector3d(0, 0, r + h)) > r + 0.15;
+    // Room to search at the take-off height: nothing within clearance_radius_m of the column.
+    const double z = p.z() + cfg_.vehicle.takeoff_height_m + r;
+    for (double rad = 0.5; free && rad <= cfg_.placement.clearance_radius_m + 1e-9; rad += 0.5)
+      for (int k = 0; free && k < 16; ++k)
+        free = world_.signed_distance({p.x() + rad * std::cos(k * kPi / 8), p.y() + rad * std::sin(k * kPi / 8), z}) >
+               r + 0.2;
+    if (!free) continue;
+    start.position = p;
+    placed = true;
+  }
+  if (!placed)
+    throw std::invalid_argument("flight simulator: no free take-off point between " +
+                                std::to_string(cfg_.placement.start_distance_min_m) + " and " +
+                                std::to_string(cfg_.placement.start_distance_max_m) + " m from the pad");
+  start.yaw = cfg_.placement.start_yaw_deg < 1e9 ? cfg_.placement.start_yaw_deg * kDeg : 2 * kPi * u01(rng_) - kPi;
+  vehicle_ = Multirotor(cfg_.vehicle, start);
+  q_prev_ = start.pose().rotation();
+
+  // Wind: steady part from a drawn direction, gusts from their stationary distribution.
+  const double theta = 2 * kPi * u01(rng_);
+  wind_mean_ = cfg_.wind.mean_m_s * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  gust_ = cfg_.wind.gust_std() * Eigen::Vector3d(n01(rng_), n01(rng_), 0.0);
+  for (auto& axis : vib_phase_) axis = {2 * kPi * u01(rng_), 2 * kPi * u01(rng_), 0.85, 1.15};
+}
+
+int64_t FlightSim::utime_of(double t) const { return cfg_.start_utime + std::llround(t * 1e6); }
+
+double FlightSim::support_height(const Eigen::Vector3d& p) const {
+  double z = world_.bounds().min.z();
+  for (const auto& o : world_.obstacles()) {
+    const Aabb& b = o.box;
+    if (p.x() >= b.min.x() && p.x() <= b.max.x() && p.y() >= b.min.y() && p.y() <= b.max.y() &&
+        b.max.z() <= p.z() + 0.05)
+      z = std::max(z, b.max.z());
+  }
+  return z;
+}
+
+Eigen::Vector3d FlightSim::wind_step(double dt) {
+  // First-order Gauss-Markov gusts per horizontal axis, exact discretisation.
+  const double a = std::exp(-dt / cfg_.wind.gust_time_constant_s), k = std::sqrt(1 - a * a) * cfg_.wind.gust_std();
+  std::normal_distribution<double> n01(0.0, 1.0);
+  gust_.x() = a * gust_.x() + k * n01(rng_);
+  gust_.y() = a * gust_.y() + k * n01(rng_);
+  return wind_mean_ + gust_;
+}
+
+geometry::SE3 FlightSim::vibration(double t) const {
+  if (!cfg_.vibration.enabled || cfg_.vibration.amplitude_deg <= 0) return {};
+  // Two tones per axis at +-15 % of the centre frequency; each tone's amplitude makes the
+  // sum's RMS the configured one (RMS of a sine is A / sqrt(2)).
+  const double a = cfg_.vibration.amplitude_deg * kDeg;
+  Eigen::Vector3d w;
+  for (int i = 0; i < 3; ++i) {
+    const auto& p = vib_phase_[i];
+    w[i] = a * (std::sin(2 * kPi * cfg_.vibration.frequency_hz * p[2] * t + p[0]) +
+                std::sin(2 * kPi * cfg_.vibration.frequency_hz * p[3] * t + p[1]));
+  }
+  return geometry::SE3::from_rotation_vector(w, Eigen::Vector3d::Zero());
+}
+
+std::string FlightSim::command(const CommandInput& c) {
+  const auto& p = cfg_.vehicle;
+  std::string why;
+  const bool finite = std::isfinite(c.velocity[0]) && std::isfinite(c.velocity[1]) && std::isfinite(c.velocity[2]) &&
+                      std::isfinite(c.yaw_rate_deg_s);
+  if (c.mode < 0 || c.mode > 4) {
+    why = "unknown mode " + std::to_string(c.mode);
+  } else if (!finite) {
+    why = "velocity or yaw rate is not finite";
+  } else if (std::hypot(c.velocity[0], c.velocity[1]) > 1.5 * p.max_horizontal_speed_m_s) {
+    why = "horizontal speed " + std::to_string(std::hypot(c.velocity[0], c.velocity[1])) + " m/s exceeds 1.5 x the limit";
+  } else if (std::abs(c.velocity[2]) > 1.5 * p.max_vertical_speed_m_s) {
+    why = "vertical speed " + std::to_string(c.velocity[2]) + " m/s exceeds 1.5 x the limit";
+  } else if (std::abs(c.yaw_rate_deg_s) > 1.5 * p.base.max_yaw_rate_deg_s) {
+    why = "yaw rate " + std::to_string(c.yaw_rate_deg_s) + " deg/s exceeds 1.5 x the limit";
+  }
+  AutopilotCommand a;  // refused: hold (hover)
+  if (why.empty()) {
+    using Mode = AutopilotCommand::Mode;
+    static constexpr Mode kModes[] = {Mode::Hover, Mode::Velocity, Mode::Hover, Mode::Takeoff, Mode::Land};
+    a.mode = kModes[c.mode];
+    a.velocity = {c.velocity[0], c.velocity[1], c.velocity[2]};
+    a.yaw_rate_deg_s = c.yaw_rate_deg_s;
+    ++applied_;
+  } else {
+    ++refused_;
+    last_refusal_ = why;
+  }
+  vehicle_.command(t_, a);
+  return why;
+}
+
+void FlightSim::physics_step(double dt) {
+  if (outcome_.collided || outcome_.landed) return;
+  const Eigen::Vector3d wind = wind_step(dt);
+  const double vz_before = vehicle_.state().velocity.z();
+  vehicle_.step(t_, dt, wind);
+  const auto& s = vehicle_.state();
+  const double z_support = support_height(s.position);
+  if (s.position.z() <= z_support) {
+    const double vz = std::min(vz_before, s.velocity.z());
+    if (airborne_) {
+      if (-vz > cfg_.vehicle.max_touchdown_speed_m_s) {
+        outcome_.collided = true;
+        outcome_.collision = "hard landing at " + std::to_string(-vz) + " m/s";
+      }
+      if (outcome_.touchdown_time_s < 0) {
+        outcome_.touchdown_time_s = t_ + dt;
+        outcome_.touchdown_position = {s.position.x(), s.position.y(), z_support};
+        outcome_.touchdown_yaw = s.yaw;
+        outcome_.touchdown_vertical_speed = -vz;
+      }
+    }
+    vehicle_.set_contact(z_support);
+    airborne_ = false;
+    if (!vehicle_.state().armed && outcome_.touchdown_time_s >= 0 && !outcome_.collided) outcome_.landed = true;
+  } else if (s.position.z() > z_support + 0.05) {
+    airborne_ = true;
+  }
+  // Anything but the surface it stands on within the rotor radius is a collision.
+  const double r = cfg_.vehicle.radius_m;
+  const Eigen::Vector3d centre = vehicle_.state().position + Eigen::Vector3d(0, 0, r);
+  const double d = world_.signed_distance(centre);
+  if (!outcome_.collided && d < r - 0.02) {
+    outcome_.collided = true;
+    outcome_.collision = "rotor " + std::to_string(d) + " m from a surface at (" +
+                         std::to_string(centre.x()) + ", " + std::to_string(centre.y()) + ", " +
+                         std::to_string(centre.z()) + ")";
+  }
+}
+
+FlightFrame FlightSim::step() {
+  FlightFrame f;
+  const int substeps = static_cast<int>(std::lround(cfg_.imu.rate_hz / cfg_.frame_rate_hz));
+  const double dt = 1.0 / cfg_.imu.rate_hz;
+  auto imu_sample = [&](double t) {
+    const auto& s = vehicle_.state();
+    const Eigen::Quaterniond q = s.pose().rotation();
+    const Eigen::AngleAxisd turn(q_prev_.conjugate() * q);
+    const Eigen::Vector3d omega = turn.angle() * turn.axis() / dt;
+    q_prev_ = q;
+    f.imu.push_back(imu_.sample(t, q, omega, s.armed ? s.acceleration : Eigen::Vector3d::Zero()));
+  };
+  if (frame_ < 0) {
+    imu_sample(0.0);
+  } else {
+    for (int i = 1; i <= substeps; ++i) {
+      physics_step(dt);
+      t_ = (frame_ * substeps + i) * dt;
+      imu_sample(t_);
+    }
+  }
+  ++frame_;
+  t_ = frame_ / cfg_.frame_rate_hz;
+  if (t_ >= cfg_.max_time_s && !outcome_.ended()) outcome_.timed_out = true;
+
+  f.seq = frame_;
+  f.t = t_;
+  f.utime = utime_of(t_);
+  f.vehicle = vehicle_.state();
+  f.wind = wind_mean_ + gust_;
+  const geometry::SE3 T_world_body = f.vehicle.pose();
+  f.T_world_down = T_world_body * T_body_down_ * vibration(t_);
+  f.down = down_.render_mono(f.T_world_down, f.utime, f.seq);
+  if (cfg_.stereo) {
+    f.T_world_left = T_world_body * T_body_left_ * vibration(t_ + 0.37);
+    f.stereo = forward_.render(f.T_world_left, f.utime, f.seq);
+  }
+  f.target = target_in(f.T_world_down);
+  return f;
+}
+
+TargetTruth FlightSim::target_in(const geometry::SE3& T_world_cam) const {
+  const Helipad& pad = world_.helipad();
+  const geometry::SE3 T_cam_world = T_world_cam.inverse();
+  TargetTruth t;
+  t.position = T_cam_world * pad.center;
+  const Eigen::Vector3d axis = T_cam_world.rotation() * Eigen::Vector3d(std::cos(pad.yaw), std::sin(pad.yaw), 0.0);
+  t.yaw = wrap_half_turn(std::atan2(axis.y(), axis.x()));
+  return t;
+}
+
+LandingScore score_landing(const FlightSim& sim, double max_error_m, double max_yaw_deg) {
+  const FlightOutcome& o = sim.outcome();
+  LandingScore s;
+  if (o.touchdown_time_s < 0) return s;
+  const Helipad& pad = sim.world().helipad();
+  s.touchdown_error_m = (o.touchdown_position - pad.center).head<2>().norm();
+  s.yaw_error_deg = wrap_half_turn(o.touchdown_yaw - pad.yaw) / kDeg;
+  s.time_s = o.touchdown_time_s;
+  s.success = o.landed && !o.collided && !o.timed_out && s.touchdown_error_m <= max_error_m &&
+              std::abs(s.yaw_error_deg) < max_yaw_deg;
+  return s;
+}
+
+}  // namespace aerie::sim

@@ -1,0 +1,105 @@
+// aerie-flightsim: the closed-loop flight simulator as an LCM node. It publishes IMU,
+// CAM_DOWN (and CAM_STEREO), GT_POSE, GT_TRACK and SIM_STATE, and moves the vehicle by
+// CTRL_CMD alone; lock-step (default) or real time. At the end of the flight it prints
+// one line: landed or not, touchdown error, yaw error, time. See docs/sim.md.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <thread>
+
+#include "common/bus/node.hpp"
+#include "common/sim/flight/flight_config.hpp"
+#include "common/sim/flight/node/flightsim_node.hpp"
+#include "common/util/cli.hpp"
+#include "common/util/time.hpp"
+
+using namespace aerie;
+
+int main(int argc, char** argv) {
+  CLI::App app{"aerie-flightsim: closed-loop flight simulator (CTRL_CMD -> IMU, CAM_DOWN, CAM_STEREO, GT_*, SIM_STATE)"};
+  util::CommonOptions common;
+  common.config = "config/sim/landing_room.yaml";
+  util::add_common_options(app, common);
+  std::string mode = "lockstep";
+  double speed = 1.0, timeout = 5.0, wind = -1, linger = 1.0;
+  int64_t seed = -1;
+  std::string vibration;
+  std::vector<std::string> answers{"CTRL_CMD"};
+  bool stereo = false;
+  std::string result_path;
+  app.add_option("--mode", mode, "lockstep: frame k+1 only after every answer channel answered frame k; "
+                                 "realtime: frames at wall-clock rate")
+      ->check(CLI::IsMember({"lockstep", "realtime"}));
+  app.add_option("--speed", speed, "real-time factor (realtime mode)")->check(CLI::PositiveNumber);
+  app.add_option("--answer", answers, "lock-step answer channels (default CTRL_CMD)");
+  app.add_option("--answer-timeout", timeout, "wall seconds to wait for an answer before counting a timeout")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", seed, "seed of placement, wind, vibration, IMU and image noise (overrides the config)");
+  app.add_option("--wind", wind, "mean wind in m/s (gusts 0.3 x that; overrides the config)");
+  app.add_option("--vibration", vibration, "camera vibration on|off (overrides the config)")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_flag("--stereo", stereo, "also render and publish the forward stereo pair (CAM_STEREO)");
+  app.add_option("--linger", linger, "seconds to keep publishing after the flight ended");
+  app.add_option("--result", result_path, "also write the one-line result into this file");
+  CLI11_PARSE(app, argc, argv);
+  util::init_logging("flightsim", common.log_level);
+  try {
+    const util::Config cfg = common.config.empty() ? util::Config() : util::Config::load(common.config);
+    sim::FlightSimConfig fc = sim::load_flight_config(cfg);
+    if (seed >= 0) fc.seed = static_cast<uint64_t>(seed);
+    if (wind >= 0) fc.wind.mean_m_s = wind;
+    if (!vibration.empty()) fc.vibration.enabled = vibration == "on";
+    if (stereo) fc.stereo = true;
+    sim::FlightSim simulator(fc);
+    bus::Bus bus(common.lcm_url);
+    bus::StatusReporter status(bus, "flightsim");
+    sim::FlightSimNodeOptions opt;
+    opt.lockstep = mode == "lockstep";
+    opt.answer_channels = answers;
+    opt.answer_timeout_s = timeout;
+    sim::FlightSimNode node(bus, simulator, opt);
+    bus::install_stop_handlers();
+    spdlog::info("{} world, seed {}, wind {} m/s, vibration {}, {} at {} Hz", fc.world.kind, fc.seed, fc.wind.mean_m_s,
+                 fc.vibration.enabled ? "on" : "off", opt.lockstep ? "lock-step" : "real time", fc.frame_rate_hz);
+    const int64_t wall0 = util::wall_utime();
+    double ended_at = -1;
+    while (!bus::stop_requested()) {
+      const auto& f = node.publish_next();
+      if (opt.lockstep) {
+        node.wait_answers();
+      } else {
+        const int64_t due = wall0 + static_cast<int64_t>((f.t + 1.0 / fc.frame_rate_hz) / speed * 1e6);
+        for (int64_t now = util::wall_utime(); now < due && !bus::stop_requested(); now = util::wall_utime())
+          bus.handle(static_cast<int>(std::max<int64_t>(1, (due - now) / 1000)));
+      }
+      node.report(status);
+      status.tick();
+      if (simulator.outcome().ended() && ended_at < 0) ended_at = f.t;
+      if (ended_at >= 0 && f.t >= ended_at + linger) break;
+    }
+    const auto& o = simulator.outcome();
+    const sim::LandingScore score = sim::score_landing(simulator);
+    char line[256];
+    if (o.landed)
+      std::snprintf(line, sizeof line,
+                    "LANDED (%s) after %.1f s: touchdown error %.3f m, yaw error %.1f deg, %lld lock-step timeouts",
+                    score.success ? "success" : "outside the success bounds", score.time_s, score.touchdown_error_m,
+                    score.yaw_error_deg, static_cast<long long>(node.lockstep_timeouts()));
+    else
+      std::snprintf(line, sizeof line, "NOT LANDED (%s) after %.1f s",
+                    o.collided ? ("collision: " + o.collision).c_str() : o.timed_out ? "timed out" : "stopped",
+                    simulator.time());
+    std::printf("flightsim: %s\n", line);
+    if (!result_path.empty()) {
+      std::FILE* f = std::fopen(result_path.c_str(), "w");
+      if (!f) throw std::runtime_error("--result: cannot write '" + result_path + "'");
+      std::fprintf(f, "%s\n", line);
+      std::fclose(f);
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}

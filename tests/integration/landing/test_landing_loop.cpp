@@ -1,0 +1,104 @@
+// Closed-loop landings: lock-step determinism (the same seed gives the same messages, byte
+// for byte) and a landing with a tracker of each family.
+#include <aerie/track_t.hpp>
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "air/pilot/pilot_config.hpp"
+#include "common/sim/flight/flight_config.hpp"
+#include "tools/landing/landing_run.hpp"
+
+using namespace aerie;
+
+namespace {
+
+landing::RunConfig config(const std::string& tracker, uint64_t seed) {
+  landing::RunConfig rc;
+  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
+  rc.sim.seed = seed;
+  rc.sim.max_time_s = 60;
+  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
+  rc.track.tracker = tracker;
+  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
+  return rc;
+}
+
+struct Message {
+  std::string channel;
+  std::vector<uint8_t> bytes;
+  bool operator==(const Message&) const = default;
+};
+
+// Every message of a run; TRACK with its processing time (wall clock) zeroed.
+std::vector<Message> record(landing::RunConfig rc, landing::RunResult* result = nullptr) {
+  std::vector<Message> out;
+  rc.on_message = [&](const std::string& channel, const uint8_t* data, size_t size) {
+    Message m{channel, {data, data + size}};
+    if (channel == "TRACK") {
+      aerie::track_t t;
+      if (t.decode(data, 0, static_cast<int>(size)) > 0) {
+        t.processing_ms = 0;
+        m.bytes.resize(static_cast<size_t>(t.getEncodedSize()));
+        t.encode(m.bytes.data(), 0, static_cast<int>(m.bytes.size()));
+      }
+    }
+    out.push_back(std::move(m));
+  };
+  const landing::RunResult r = landing::fly(rc);
+  if (result) *result = r;
+  return out;
+}
+
+}  // namespace
+
+TEST(LandingLoop, LockStepRunsWithTheSameSeedGiveTheSameMessages) {
+  landing::RunConfig rc = config("amcmr-ct", 5);
+  rc.sim.wind.mean_m_s = 1.0;
+  rc.sim.vibration.enabled = true;
+  landing::RunResult ra, rb;
+  const std::vector<Message> a = record(rc, &ra), b = record(rc, &rb);
+  ASSERT_TRUE(ra.outcome.ended());
+  EXPECT_EQ(ra.lockstep_timeouts, 0);
+  ASSERT_EQ(a.size(), b.size());
+  size_t first_diff = a.size();
+  for (size_t i = 0; i < a.size() && first_diff == a.size(); ++i)
+    if (!(a[i] == b[i])) first_diff = i;
+  EXPECT_EQ(first_diff, a.size()) << "first difference at message " << first_diff << " on " << a[first_diff].channel;
+  EXPECT_EQ(ra.score.touchdown_error_m, rb.score.touchdown_error_m);
+  // Every channel of the loop took part.
+  for (const char* ch : {"IMU", "CAM_DOWN", "GT_TRACK", "SIM_STATE", "TRACK", "TARGET_POSE", "CTRL_CMD", "PILOT_STATE"}) {
+    bool seen = false;
+    for (const auto& m : a) seen |= m.channel == ch;
+    EXPECT_TRUE(seen) << ch;
+  }
+}
+
+class LandingPerTracker : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LandingPerTracker, LandsOnThePad) {
+  landing::RunConfig rc = config(GetParam(), 2);
+  rc.sim.placement.start_distance_min_m = 0.5;
+  rc.sim.placement.start_distance_max_m = 1.0;
+  rc.pilot.survey_legs.clear();
+  const landing::RunResult r = landing::fly(rc);
+  EXPECT_TRUE(r.outcome.landed) << r.final_state << " " << r.outcome.collision;
+  EXPECT_TRUE(r.score.success) << "touchdown error " << r.score.touchdown_error_m << " m, yaw " << r.score.yaw_error_deg;
+  EXPECT_LT(r.score.touchdown_error_m, 0.15);
+  EXPECT_EQ(r.final_state, "LANDED");
+  EXPECT_GT(r.descent.size(), 5u);
+  EXPECT_LT(r.rmse(0), 0.05);  // TARGET_POSE against the truth during the descent
+  EXPECT_LT(r.rmse(2), 0.05);
+  EXPECT_EQ(r.lockstep_timeouts, 0);
+  EXPECT_EQ(r.commands_refused, 0);
+}
+
+// One tracker per family: IPSL (hierarchical), CT (AMCMR), MIL (AM3), correlation filter, OpenCV.
+INSTANTIATE_TEST_SUITE_P(Families, LandingPerTracker, ::testing::Values("ipsl-mr", "amcmr-ct", "am3", "dcf", "opencv-csrt"),
+                         [](const auto& info) {
+                           std::string n = info.param;
+                           for (char& c : n)
+                             if (c == '-') c = '_';
+                           return n;
+                         });
