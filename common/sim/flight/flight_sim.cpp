@@ -52,29 +52,68 @@ void FlightSimConfig::validate() const {
   need(down_camera.width > 0 && down_camera.height > 0, "down_camera size must be > 0");
 }
 
+// The world of layout `layout` (0, then 1, 2, ... when a layout has no free take-off
+// point): its obstacles and textures, the pad's place and yaw all come from the seed.
+World FlightSim::draw_world(int layout) {
+  WorldConfig w = cfg_.world;
+  w.seed = mix_seed(cfg_.seed, 7000 + 10 * static_cast<uint64_t>(layout));
+  std::mt19937_64 placement(mix_seed(cfg_.seed, 7001 + 10 * static_cast<uint64_t>(layout)));
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  w.helipad_yaw_deg = cfg_.placement.pad_yaw_deg < 0 ? 180.0 * u01(placement) : cfg_.placement.pad_yaw_deg;
+  if (w.kind == "room" && std::isnan(cfg_.world.helipad_x) && std::isnan(cfg_.world.helipad_y)) {
+    // Anywhere in the middle half of the room (the field places its car itself).
+    w.helipad_x = (u01(placement) - 0.5) * 0.5 * w.room_x;
+    w.helipad_y = (u01(placement) - 0.5) * 0.5 * w.room_y;
+  }
+  return World::make(w);
+}
+
+std::optional<Eigen::Vector3d> FlightSim::takeoff_point() {
+  // On free ground at the drawn distance from the pad, with room to climb and to search.
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const Helipad& pad = world_.helipad();
+  const double r = cfg_.vehicle.radius_m;
+  for (int attempt = 0; attempt < 500; ++attempt) {
+    const double d = cfg_.placement.start_distance_min_m +
+                     (cfg_.placement.start_distance_max_m - cfg_.placement.start_distance_min_m) * u01(rng_);
+    const double phi = 2 * kPi * u01(rng_);
+    Eigen::Vector3d p(pad.center.x() + d * std::cos(phi), pad.center.y() + d * std::sin(phi), 10.0);
+    p.z() = support_height(p);
+    bool free = p.z() <= world_.bounds().min.z() + 1e-9;  // on the ground, not on an object
+    for (double h = 0.2; free && h <= cfg_.vehicle.takeoff_height_m + 0.3; h += 0.1)  // the column it climbs
+      free = world_.signed_distance(p + Eigen::Vector3d(0, 0, r + h)) > r + 0.15;
+    // Nothing within clearance_radius_m of the column at the take-off height.
+    const double z = p.z() + cfg_.vehicle.takeoff_height_m + r;
+    for (double rad = 0.5; free && rad <= cfg_.placement.clearance_radius_m + 1e-9; rad += 0.5)
+      for (int k = 0; free && k < 16; ++k)
+        free = world_.signed_distance({p.x() + rad * std::cos(k * kPi / 8), p.y() + rad * std::sin(k * kPi / 8), z}) >
+               r + 0.2;
+    if (free) return p;
+  }
+  return std::nullopt;
+}
+
 FlightSim::FlightSim(const FlightSimConfig& config)
     : cfg_(config),
-      world_([&] {
-        cfg_.validate();
-        // The world's layout and textures, the pad's place and yaw all come from the seed.
-        WorldConfig w = cfg_.world;
-        w.seed = mix_seed(cfg_.seed, 7000);
-        std::mt19937_64 placement(mix_seed(cfg_.seed, 7001));
-        std::uniform_real_distribution<double> u01(0.0, 1.0);
-        w.helipad_yaw_deg = cfg_.placement.pad_yaw_deg < 0 ? 180.0 * u01(placement) : cfg_.placement.pad_yaw_deg;
-        if (w.kind == "room" && std::isnan(w.helipad_x) && std::isnan(w.helipad_y)) {
-          // Anywhere in the middle half of the room (the field places its car itself).
-          w.helipad_x = (u01(placement) - 0.5) * 0.5 * w.room_x;
-          w.helipad_y = (u01(placement) - 0.5) * 0.5 * w.room_y;
-        }
-        cfg_.world = w;
-        return World::make(w);
-      }()),
+      world_((cfg_.validate(), draw_world(0))),
       down_(world_, cfg_.down_camera),
       forward_(world_, cfg_.stereo_rig),
       vehicle_(cfg_.vehicle, {}),
       imu_(cfg_.imu, mix_seed(cfg_.seed, 7002)),
       rng_(mix_seed(cfg_.seed, 7003)) {
+  std::optional<Eigen::Vector3d> start_point = takeoff_point();
+  constexpr int kLayouts = 10;
+  for (int layout = 1; !start_point && layout < kLayouts; ++layout) {
+    world_ = draw_world(layout);
+    start_point = takeoff_point();
+  }
+  if (!start_point)
+    throw std::invalid_argument("flight simulator: no free take-off point between " +
+                                std::to_string(cfg_.placement.start_distance_min_m) + " and " +
+                                std::to_string(cfg_.placement.start_distance_max_m) + " m from the pad in " +
+                                std::to_string(kLayouts) + " layouts; lower n_obstacles or clearance_radius_m");
+  cfg_.world = world_.config();
+
   // Lighting, image noise.
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const double j = cfg_.placement.exposure_jitter;
@@ -89,34 +128,8 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   T_body_down_ = body_to_left(down);
   T_body_left_ = body_to_left(fwd);
 
-  // Take-off point: on free ground at the drawn distance from the pad, with room to climb.
-  const Helipad& pad = world_.helipad();
-  const double r = cfg_.vehicle.radius_m;
   MultirotorState start;
-  bool placed = false;
-  for (int attempt = 0; attempt < 500 && !placed; ++attempt) {
-    const double d = cfg_.placement.start_distance_min_m +
-                     (cfg_.placement.start_distance_max_m - cfg_.placement.start_distance_min_m) * u01(rng_);
-    const double phi = 2 * kPi * u01(rng_);
-    Eigen::Vector3d p(pad.center.x() + d * std::cos(phi), pad.center.y() + d * std::sin(phi), 10.0);
-    p.z() = support_height(p);
-    bool free = p.z() <= world_.bounds().min.z() + 1e-9;  // on the ground, not on an object
-    for (double h = 0.2; free && h <= cfg_.vehicle.takeoff_height_m + 0.3; h += 0.1)  // the column it climbs
-      free = world_.signed_distance(p + Eigen::Vector3d(0, 0, r + h)) > r + 0.15;
-    // Room to search at the take-off height: nothing within clearance_radius_m of the column.
-    const double z = p.z() + cfg_.vehicle.takeoff_height_m + r;
-    for (double rad = 0.5; free && rad <= cfg_.placement.clearance_radius_m + 1e-9; rad += 0.5)
-      for (int k = 0; free && k < 16; ++k)
-        free = world_.signed_distance({p.x() + rad * std::cos(k * kPi / 8), p.y() + rad * std::sin(k * kPi / 8), z}) >
-               r + 0.2;
-    if (!free) continue;
-    start.position = p;
-    placed = true;
-  }
-  if (!placed)
-    throw std::invalid_argument("flight simulator: no free take-off point between " +
-                                std::to_string(cfg_.placement.start_distance_min_m) + " and " +
-                                std::to_string(cfg_.placement.start_distance_max_m) + " m from the pad");
+  start.position = *start_point;
   start.yaw = cfg_.placement.start_yaw_deg < 1e9 ? cfg_.placement.start_yaw_deg * kDeg : 2 * kPi * u01(rng_) - kPi;
   vehicle_ = Multirotor(cfg_.vehicle, start);
   q_prev_ = start.pose().rotation();

@@ -148,6 +148,8 @@ class FlightSim {
   TargetTruth target_in(const geometry::SE3& T_world_cam) const;
 
  private:
+  World draw_world(int layout);
+  std::optional<Eigen::Vector3d> takeoff_point();
   void physics_step(double dt);
   Eigen::Vector3d wind_step(double dt);
   geometry::SE3 vibration(double t) const;

@@ -91,7 +91,8 @@ bool PilotOverlay::update() {
 
 std::string PilotOverlay::banner(const aerie::pilot_state_t& s) {
   char text[160];
-  if (s.target_valid)
+  const bool landing = s.state == aerie::pilot_state_t::TOUCHDOWN || s.state == aerie::pilot_state_t::LANDED;
+  if (s.target_valid && !landing)
     std::snprintf(text, sizeof text, "%s  h %.2f m  off %.2f m  yaw %+.1f deg  losses %d", s.state_name.c_str(),
                   s.height_m, std::hypot(s.target_body[0], s.target_body[1]), s.target_yaw_error_deg, s.losses);
   else

@@ -160,12 +160,9 @@ bool FlightSimNode::wait_answers() {
     const int64_t left = deadline - util::wall_utime();
     if (left <= 0) {
       ++timeouts_;
-      spdlog::warn("lock-step: no answer to frame {} on {} within {} s (counted; going on)", frame_.seq,
-                   [&] {
-                     std::string s;
-                     for (const auto& ch : opt_.answer_channels) s += (s.empty() ? "" : ", ") + ch;
-                     return s;
-                   }(),
+      std::string channels;
+      for (const auto& ch : opt_.answer_channels) channels += (channels.empty() ? "" : ", ") + ch;
+      spdlog::warn("lock-step: no answer to frame {} on {} within {} s (counted; going on)", frame_.seq, channels,
                    opt_.answer_timeout_s);
       return false;
     }

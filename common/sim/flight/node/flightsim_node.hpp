@@ -26,7 +26,6 @@
 namespace aerie::sim {
 
 struct FlightSimNodeOptions {
-  bool lockstep = true;
   std::vector<std::string> answer_channels{"CTRL_CMD"};
   double answer_timeout_s = 5.0;  // wall time per frame before a missing answer is counted
   std::string command_channel = "CTRL_CMD";

@@ -51,22 +51,24 @@ int main(int argc, char** argv) {
     if (wind >= 0) fc.wind.mean_m_s = wind;
     if (!vibration.empty()) fc.vibration.enabled = vibration == "on";
     if (stereo) fc.stereo = true;
+    // Real time: message time is wall time, so that latency tools and other nodes' clocks agree.
+    if (mode == "realtime" && fc.start_utime == 0) fc.start_utime = util::wall_utime();
     sim::FlightSim simulator(fc);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "flightsim");
+    const bool lockstep = mode == "lockstep";
     sim::FlightSimNodeOptions opt;
-    opt.lockstep = mode == "lockstep";
     opt.answer_channels = answers;
     opt.answer_timeout_s = timeout;
     sim::FlightSimNode node(bus, simulator, opt);
     bus::install_stop_handlers();
     spdlog::info("{} world, seed {}, wind {} m/s, vibration {}, {} at {} Hz", fc.world.kind, fc.seed, fc.wind.mean_m_s,
-                 fc.vibration.enabled ? "on" : "off", opt.lockstep ? "lock-step" : "real time", fc.frame_rate_hz);
+                 fc.vibration.enabled ? "on" : "off", lockstep ? "lock-step" : "real time", fc.frame_rate_hz);
     const int64_t wall0 = util::wall_utime();
     double ended_at = -1;
     while (!bus::stop_requested()) {
       const auto& f = node.publish_next();
-      if (opt.lockstep) {
+      if (lockstep) {
         node.wait_answers();
       } else {
         const int64_t due = wall0 + static_cast<int64_t>((f.t + 1.0 / fc.frame_rate_hz) / speed * 1e6);
