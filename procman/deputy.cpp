@@ -120,19 +120,50 @@ Deputy::OrdersResult Deputy::handle_orders(const bot_procman::orders2_t& orders,
     return OrdersResult::Stale;
   }
 
+  // The newest orders are obeyed (libbot2), whoever sent them; a change of sheriff
+  // is said on PMD_PRINTF so that the operator sees who took over.
+  if (orders.sheriff_name != last_sheriff_name_) {
+    if (!last_sheriff_name_.empty())
+      say(0, "taking orders from sheriff '" + orders.sheriff_name + "' (previous orders came from '" +
+                 last_sheriff_name_ + "')");
+    last_sheriff_name_ = orders.sheriff_name;
+  }
+
   for (const auto& sc : orders.cmds) {
+    if (sc.sheriff_id == 0) continue;  // 0 is the deputy's own id (printf_t), never a command's
     auto [it, fresh] = commands_.try_emplace(sc.sheriff_id);
     Command& c = it->second;
     if (fresh) {
+      // An id this deputy does not know: a new command. Its run id is 0, so it
+      // starts only when the orders ask for a run (desired_runid != 0, force_quit 0).
       c.sheriff_id = sc.sheriff_id;
       c.cmd = sc.cmd;
       c.backoff_ms = options_.respawn_min_ms;
       any = true;
+    } else if (c.cmd.command_name != sc.cmd.command_name) {
+      // The id now names another command (ids reused by a different sheriff, or an
+      // old sheriff numbering 1..N). What we hold under it is not what the orders
+      // name: it is stopped, and its run history is not inherited by the new
+      // command, which these orders do not start (run id taken as current); the
+      // sheriff starts it by changing desired_runid.
+      say(0, "sheriff '" + orders.sheriff_name + "' names id " + std::to_string(sc.sheriff_id) + " [" +
+                 sc.cmd.command_name + "], which here was [" + c.cmd.command_name + "]" +
+                 (c.pid != 0 ? ": stopping [" + c.cmd.command_name + "]" : "") + "; [" + sc.cmd.command_name +
+                 "] starts when the sheriff asks for a new run");
+      if (c.pid != 0) {
+        if (c.superseded_name.empty()) c.superseded_name = c.cmd.command_name;
+        stop(c, now);
+      }
+      c.cmd = sc.cmd;
+      c.actual_runid = sc.desired_runid;
+      c.respawn_at_ms = -1;
+      c.restarts = 0;
+      c.backoff_ms = options_.respawn_min_ms;
+      if (c.pid == 0) c.exit_status = 0;
+      any = true;
     } else {
       // A changed exec string takes effect at the next start (as in libbot2).
-      if (c.cmd.exec_str != sc.cmd.exec_str || c.cmd.command_name != sc.cmd.command_name ||
-          c.cmd.group != sc.cmd.group)
-        any = true;
+      if (c.cmd.exec_str != sc.cmd.exec_str || c.cmd.group != sc.cmd.group) any = true;
       c.cmd = sc.cmd;
     }
     c.desired_runid = sc.desired_runid;
@@ -314,7 +345,14 @@ void Deputy::on_exit(Command& c, int status, int64_t now) {
   c.stop_sent_ms = -1;
   c.cpu_usage = 0;
   c.vsize_bytes = c.rss_bytes = 0;
-  if (!was_stopping || status != 0) say(c.sheriff_id, "[" + c.cmd.command_name + "] " + describe_status(status));
+  if (!c.superseded_name.empty()) {
+    // What ended was the command that held this id before: not the current one's exit.
+    say(0, "[" + c.superseded_name + "] (id " + std::to_string(c.sheriff_id) + ") " + describe_status(status));
+    c.superseded_name.clear();
+    c.exit_status = 0;
+  } else if (!was_stopping || status != 0) {
+    say(c.sheriff_id, "[" + c.cmd.command_name + "] " + describe_status(status));
+  }
   if (c.remove_requested || exiting_) return;
 
   if (!c.force_quit && c.desired_runid != c.actual_runid) {

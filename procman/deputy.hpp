@@ -9,6 +9,13 @@
 //   force_quit is 0, stops when force_quit is set, restarts when the run id changes
 //   while running; commands absent from the orders are stopped and removed.
 //   Orders older than max_order_age_s are refused ("check the clocks").
+// * Safety against stale commands: an id the deputy does not know is a new command
+//   (run id 0), started only when the orders ask for a run (desired_runid != 0 and
+//   force_quit 0). An id the deputy knows under another command name (reused by a
+//   different sheriff) is a different command: the old one is stopped, and the new
+//   one inherits no run id, so it is not started until the sheriff changes
+//   desired_runid. The newest orders are obeyed whatever the sheriff's name; a change
+//   of sheriff is reported on the output (sheriff id 0).
 // * A command runs in its own session on a pseudo-terminal (so its output is
 //   line-buffered); everything it writes is passed to the output callback.
 // * Stop: stop_signal to the command's session and descendants, SIGKILL after
@@ -65,6 +72,7 @@ class Deputy {
     int backoff_ms = 0;
     int32_t restarts = 0;            // automatic respawns
     std::vector<pid_t> stop_targets;  // processes signalled when stopping
+    std::string superseded_name;     // the running process is an earlier command of this id, being stopped
     // usage over the last sampling period
     uint64_t last_jiffies = 0;
     float cpu_usage = 0;
@@ -120,6 +128,7 @@ class Deputy {
   std::map<int32_t, Command> commands_;
   bool exiting_ = false;
   int64_t last_stale_warning_ms_ = -1000000;
+  std::string last_sheriff_name_;  // who sent the last orders applied
   HostSample host_;  // the last sample: memory, and the jiffies the CPU load is measured from
   float cpu_load_ = 0;
 };

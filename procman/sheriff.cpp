@@ -1,9 +1,11 @@
 #include "procman/sheriff.hpp"
 
+#include <signal.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,14 +24,22 @@ const char* to_string(CommandStatus s) {
   }
 }
 
-Sheriff::Sheriff(std::string name, bool observer, double deputy_timeout_s)
-    : name_(std::move(name)), observer_(observer), deputy_timeout_ms_(static_cast<int64_t>(deputy_timeout_s * 1000)) {}
+Sheriff::Sheriff(std::string name, bool observer, double deputy_timeout_s, uint64_t seed)
+    : name_(std::move(name)),
+      observer_(observer),
+      deputy_timeout_ms_(static_cast<int64_t>(deputy_timeout_s * 1000)),
+      rng_([seed] {
+        std::random_device rd;
+        std::seed_seq seq = seed != 0 ? std::seed_seq{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)}
+                                      : std::seed_seq{rd(), rd(), rd(), rd()};
+        return std::mt19937(seq);
+      }()) {}
 
 void Sheriff::load(const PmdConfig& config) {
   for (const auto& pc : config.commands) {
     SheriffCommand c;
     c.host = pc.host;
-    c.sheriff_id = fresh_id(pc.host);
+    c.sheriff_id = fresh_id();
     c.cmd.exec_str = pc.exec;
     c.cmd.command_name = pc.name;
     c.cmd.group = pc.group;
@@ -41,11 +51,20 @@ void Sheriff::load(const PmdConfig& config) {
   }
 }
 
-int32_t Sheriff::fresh_id(const std::string& host) const {
-  int32_t id = 0;
-  for (const auto& c : commands_)
-    if (c.host == host) id = std::max(id, c.sheriff_id);
-  return id + 1;
+bool Sheriff::id_in_use(int32_t id) const {
+  if (std::any_of(commands_.begin(), commands_.end(), [&](const SheriffCommand& c) { return c.sheriff_id == id; }))
+    return true;
+  return std::any_of(foreign_ids_.begin(), foreign_ids_.end(), [&](const auto& f) { return f.second == id; });
+}
+
+// Random in [1, 2^31 - 1] (libbot2's sheriff draws random 31-bit ids too), unique
+// among this sheriff's commands (on every host) and the ids deputies report.
+int32_t Sheriff::fresh_id() {
+  std::uniform_int_distribution<int32_t> dist(1, std::numeric_limits<int32_t>::max());
+  while (true) {
+    const int32_t id = dist(rng_);
+    if (!id_in_use(id)) return id;
+  }
 }
 
 SheriffCommand* Sheriff::find_mut(const std::string& host, int32_t sheriff_id) {
@@ -111,19 +130,44 @@ void Sheriff::restart(const std::vector<std::pair<std::string, int32_t>>& keys) 
   }
 }
 
+namespace {
+// Without having sent the order itself (an adopted command, an observer), the
+// sheriff takes a run that ended by the command's stop signal or by SIGKILL as
+// stopped on order.
+bool ended_like_a_stop(const bot_procman::deputy_cmd2_t& d) {
+  if (d.pid != 0 || d.actual_runid == 0 || !WIFSIGNALED(d.exit_code)) return false;
+  const int stop_signal = d.cmd.stop_signal > 0 ? d.cmd.stop_signal : SIGINT;
+  return WTERMSIG(d.exit_code) == stop_signal || WTERMSIG(d.exit_code) == SIGKILL;
+}
+}  // namespace
+
 void Sheriff::adopt(const bot_procman::info2_t& info) {
   for (const auto& d : info.cmds) {
     auto it = std::find_if(commands_.begin(), commands_.end(), [&](const SheriffCommand& c) {
       return c.host == info.host && c.cmd.command_name == d.cmd.command_name;
     });
-    if (it == commands_.end()) continue;
+    if (it == commands_.end()) {
+      // Not ours: the deputy will stop and forget it (our orders omit it). Keep
+      // its id away from our commands, so that no order of ours names it.
+      foreign_ids_.insert({info.host, d.sheriff_id});
+      continue;
+    }
     if (it->sheriff_id != d.sheriff_id) {
       // Take the deputy's id; a command of ours already using it gets a fresh one.
-      if (SheriffCommand* other = find_mut(info.host, d.sheriff_id)) other->sheriff_id = fresh_id(info.host);
+      if (SheriffCommand* other = find_mut(info.host, d.sheriff_id)) other->sheriff_id = fresh_id();
       it->sheriff_id = d.sheriff_id;
     }
     it->desired_runid = d.actual_runid;
     it->force_quit = false;
+    it->stopped_by_order = ended_like_a_stop(d);
+  }
+  // A command of ours whose id the deputy holds for another command gets a fresh id.
+  for (auto& c : commands_) {
+    if (c.host != info.host) continue;
+    const bool clash = std::any_of(info.cmds.begin(), info.cmds.end(), [&](const auto& d) {
+      return d.sheriff_id == c.sheriff_id && d.cmd.command_name != c.cmd.command_name;
+    });
+    if (clash) c.sheriff_id = fresh_id();
   }
 }
 
@@ -164,10 +208,16 @@ void Sheriff::on_info(const bot_procman::info2_t& info, int64_t now_ms) {
       c.reported = false;
       continue;
     }
+    if (c.reported && d->actual_runid != c.last.actual_runid) c.stopped_by_order = false;  // a new run
     if (d->pid != 0) {
       if (c.last_seen_pid != 0 && d->pid != c.last_seen_pid && d->actual_runid == c.last_seen_runid) ++c.restarts;
       c.last_seen_pid = d->pid;
       c.last_seen_runid = d->actual_runid;
+      c.stopped_by_order = false;
+    } else if (observer_) {
+      if (!c.reported || c.last.pid != 0) c.stopped_by_order = ended_like_a_stop(*d);
+    } else if (c.reported && c.last.pid != 0 && c.force_quit) {
+      c.stopped_by_order = true;  // it ended after our stop order
     }
     if (observer_) {
       c.cmd = d->cmd;
@@ -222,6 +272,7 @@ CommandStatus Sheriff::status(const SheriffCommand& c, int64_t now_ms) const {
     return CommandStatus::Running;
   }
   if (!c.force_quit && d.actual_runid != c.desired_runid) return CommandStatus::Starting;
+  if (c.stopped_by_order) return CommandStatus::Stopped;
   if (!c.force_quit && d.cmd.auto_respawn && d.actual_runid != 0) return CommandStatus::Respawning;
   const int st = d.exit_code;
   return (WIFSIGNALED(st) || (WIFEXITED(st) && WEXITSTATUS(st) != 0)) ? CommandStatus::Failed : CommandStatus::Stopped;

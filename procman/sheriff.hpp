@@ -11,6 +11,8 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <random>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,8 +28,9 @@ enum class CommandStatus {
   Restarting,  // running an older run id; will be stopped and started again
   Stopping,
   Respawning,  // ended by itself; the deputy will start it again (auto_respawn)
-  Stopped,     // not running (exited 0, or stopped on order)
-  Failed,      // ended with a non-zero exit code or a signal, no respawn
+  Stopped,     // not running: never started, exited 0, or ended after a stop order
+               // (its stop signal, SIGKILL after stop_time_allowed, or any exit then)
+  Failed,      // ended by itself with a non-zero exit code or a signal, no respawn
 };
 const char* to_string(CommandStatus s);
 
@@ -44,6 +47,9 @@ struct SheriffCommand {
   int32_t restarts = 0;             // respawns seen (pid changed within one run id)
   int32_t last_seen_pid = 0;
   int32_t last_seen_runid = 0;
+  // The last run ended after this sheriff (or, for an adopted command, its
+  // predecessor) ordered it to stop: it reads "stopped" whatever its exit status.
+  bool stopped_by_order = false;
 };
 
 struct DeputyView {
@@ -56,9 +62,13 @@ struct DeputyView {
 
 class Sheriff {
  public:
-  Sheriff(std::string name, bool observer = false, double deputy_timeout_s = 3.0);
+  // seed: for the command ids; 0 = from std::random_device (a new sheriff session).
+  Sheriff(std::string name, bool observer = false, double deputy_timeout_s = 3.0, uint64_t seed = 0);
 
-  // Adds the commands of a configuration (sheriff ids 1, 2, ...).
+  // Adds the commands of a configuration. Each gets a random 31-bit sheriff id
+  // (never 0, unique within this sheriff), as libbot2's sheriff does, so ids of
+  // different sheriff sessions do not collide on a deputy that still holds old
+  // commands.
   void load(const PmdConfig& config);
 
   // Commands named by a script target; throws std::invalid_argument for an unknown name.
@@ -98,7 +108,8 @@ class Sheriff {
  private:
   SheriffCommand* find_mut(const std::string& host, int32_t sheriff_id);
   void adopt(const bot_procman::info2_t& info);
-  int32_t fresh_id(const std::string& host) const;
+  int32_t fresh_id();
+  bool id_in_use(int32_t id) const;
 
   std::string name_;
   bool observer_;
@@ -106,6 +117,9 @@ class Sheriff {
   std::vector<SheriffCommand> commands_;
   std::map<std::string, DeputyView> deputies_;
   bool dirty_ = false;
+  std::mt19937 rng_;
+  // Ids the deputies reported that belong to no command of ours: never handed out.
+  std::set<std::pair<std::string, int32_t>> foreign_ids_;
 };
 
 // Runs a script of the configuration against a sheriff, one step at a time.

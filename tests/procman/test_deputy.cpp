@@ -340,3 +340,145 @@ TEST(Deputy, ReportsCpuAndMemory) {
   EXPECT_GT(info.phys_mem_free_bytes, 0);
   EXPECT_LE(info.phys_mem_free_bytes, info.phys_mem_total_bytes);
 }
+
+// --- Safety: no command starts unless the current orders ask for a run ----------
+
+TEST(DeputySafety, UnknownIdStartsOnlyWhenTheOrdersAskForARun) {
+  DeputyHarness h;
+  CmdSpec idle, quit, run;
+  idle.id = 1001;
+  idle.name = "idle";
+  idle.exec = "sleep 100";
+  idle.runid = 0;  // never asked to run
+  quit = idle;
+  quit.id = 1002;
+  quit.name = "quit";
+  quit.runid = 7;
+  quit.force_quit = true;  // a run id, but stopped
+  run = idle;
+  run.id = 1003;
+  run.name = "run";
+  run.runid = 1;  // asked to run
+  h.order({idle, quit, run});
+  EXPECT_EQ(h.cmd(1001)->pid, 0);
+  EXPECT_EQ(h.cmd(1002)->pid, 0);
+  EXPECT_GT(h.cmd(1003)->pid, 0);
+  h.run_for(100);
+  h.order({idle, quit, run});  // the same orders again change nothing
+  EXPECT_EQ(h.cmd(1001)->pid, 0);
+  EXPECT_EQ(h.cmd(1002)->pid, 0);
+  EXPECT_EQ(h.cmd(1002)->actual_runid, 7);
+}
+
+// The reported fault: a deputy holding stopped commands of an earlier sheriff that
+// numbered its ids 1..N gets orders of another config whose commands reuse those
+// ids with run id 0. Nothing may start.
+TEST(DeputySafety, ReusedIdsOfAnotherCommandAreNotStarted) {
+  DeputyHarness h;
+  std::vector<CmdSpec> old_cmds;
+  for (int i = 1; i <= 3; ++i) {
+    CmdSpec c;
+    c.id = i;
+    c.name = "old" + std::to_string(i);
+    c.exec = "sleep 100";
+    c.runid = 2;
+    old_cmds.push_back(c);
+  }
+  h.order(old_cmds);
+  for (int i = 1; i <= 3; ++i) ASSERT_GT(h.cmd(i)->pid, 0);
+  for (auto& c : old_cmds) c.force_quit = true;  // the first sheriff stops them
+  h.order(old_cmds);
+  ASSERT_TRUE(h.run_until([&] { return h.cmd(1)->pid == 0 && h.cmd(2)->pid == 0 && h.cmd(3)->pid == 0; }));
+  h.output.clear();
+
+  std::vector<CmdSpec> new_cmds;
+  for (int i = 1; i <= 3; ++i) {
+    CmdSpec c;
+    c.id = i;
+    c.name = "new" + std::to_string(i);
+    c.exec = "sleep 100";
+    c.runid = 0;  // a fresh sheriff, no script: nothing asked to run
+    new_cmds.push_back(c);
+  }
+  auto o = aerie::procman::test::make_orders("testhost", new_cmds);
+  o.sheriff_name = "other-sheriff";
+  ASSERT_EQ(h.deputy.handle_orders(o, aerie::util::wall_utime()), Deputy::OrdersResult::Applied);
+  h.run_for(200);
+  h.deputy.handle_orders(o, aerie::util::wall_utime());
+  for (int i = 1; i <= 3; ++i) {
+    EXPECT_EQ(h.cmd(i)->pid, 0) << "command " << i << " started without being asked";
+    EXPECT_EQ(h.cmd(i)->cmd.command_name, "new" + std::to_string(i));
+    EXPECT_EQ(h.cmd(i)->exit_status, 0);  // the old command's exit is not the new one's
+  }
+  EXPECT_NE(h.text(0).find("taking orders from sheriff 'other-sheriff'"), std::string::npos) << h.text(0);
+  EXPECT_NE(h.text(0).find("names id 1 [new1], which here was [old1]"), std::string::npos) << h.text(0);
+
+  // The new sheriff asks for a run: now it starts.
+  new_cmds[0].runid = 1;
+  o = aerie::procman::test::make_orders("testhost", new_cmds);
+  o.sheriff_name = "other-sheriff";
+  h.deputy.handle_orders(o, aerie::util::wall_utime());
+  EXPECT_GT(h.cmd(1)->pid, 0);
+  EXPECT_EQ(h.cmd(2)->pid, 0);
+}
+
+TEST(DeputySafety, ARunningCommandWhoseIdIsReusedIsStoppedAndTheNewOneWaits) {
+  DeputyHarness h;
+  CmdSpec old_cmd;
+  old_cmd.id = 5;
+  old_cmd.name = "old";
+  old_cmd.exec = "sleep 100";
+  old_cmd.runid = 3;
+  h.order({old_cmd});
+  const pid_t old_pid = h.cmd(5)->pid;
+  ASSERT_GT(old_pid, 0);
+  CmdSpec new_cmd = old_cmd;
+  new_cmd.name = "new";
+  new_cmd.runid = 1;  // differs from the old run id 3, but is not a request to start "new"
+  h.order({new_cmd});
+  ASSERT_TRUE(h.run_until([&] { return h.cmd(5)->pid == 0; }));
+  EXPECT_FALSE(alive(old_pid));
+  h.run_for(200);
+  h.order({new_cmd});
+  EXPECT_EQ(h.cmd(5)->pid, 0);
+  EXPECT_EQ(h.cmd(5)->exit_status, 0);
+  new_cmd.runid = 2;
+  h.order({new_cmd});
+  EXPECT_GT(h.cmd(5)->pid, 0);
+  EXPECT_NE(h.cmd(5)->pid, old_pid);
+}
+
+TEST(DeputySafety, ObeysTheNewestSheriffAndDropsWhatItDoesNotName) {
+  DeputyHarness h;
+  CmdSpec a;
+  a.id = 11;
+  a.name = "a";
+  a.exec = "sleep 100";
+  auto oa = aerie::procman::test::make_orders("testhost", {a});
+  oa.sheriff_name = "sheriff-A";
+  h.deputy.handle_orders(oa, aerie::util::wall_utime());
+  const pid_t pa = h.cmd(11)->pid;
+  ASSERT_GT(pa, 0);
+
+  CmdSpec b;
+  b.id = 22;
+  b.name = "b";
+  b.exec = "sleep 100";
+  b.runid = 0;
+  auto ob = aerie::procman::test::make_orders("testhost", {b});
+  ob.sheriff_name = "sheriff-B";
+  h.deputy.handle_orders(ob, aerie::util::wall_utime());
+  ASSERT_TRUE(h.run_until([&] { return h.cmd(11) == nullptr; }));
+  EXPECT_FALSE(alive(pa));
+  ASSERT_NE(h.cmd(22), nullptr);
+  EXPECT_EQ(h.cmd(22)->pid, 0);
+  EXPECT_NE(h.text(0).find("taking orders from sheriff 'sheriff-B' (previous orders came from 'sheriff-A')"),
+            std::string::npos)
+      << h.text(0);
+  // An observer sends nothing; empty orders from a sheriff with no command for
+  // this host stop and remove everything (libbot2).
+  auto empty = aerie::procman::test::make_orders("testhost", {});
+  empty.sheriff_name = "sheriff-C";
+  h.deputy.handle_orders(empty, aerie::util::wall_utime());
+  EXPECT_TRUE(h.deputy.commands().empty());
+}
