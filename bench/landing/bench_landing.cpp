@@ -24,6 +24,7 @@
 
 #include "air/pilot/pilot_config.hpp"
 #include "air/track/factory.hpp"
+#include "common/logio/event_log.hpp"
 #include "common/sim/flight/flight_config.hpp"
 #include "tools/landing/landing_run.hpp"
 
@@ -38,11 +39,23 @@ struct Setup {
 };
 
 struct Files {
-  std::string sim_dir, track, pilot;
+  std::string sim_dir, track, pilot, log_dir;
 };
 
 landing::RunResult fly(const Setup& setup, uint64_t seed, const Files& files) {
   landing::RunConfig rc;
+  std::unique_ptr<logio::Writer> log;
+  if (!files.log_dir.empty()) {
+    // Every message of the run, stamped with its own (simulation) time: lcm-logplayer and
+    // aerie-viewer replay it like a flight log.
+    log = std::make_unique<logio::Writer>(files.log_dir + "/" + setup.tracker + "-" + setup.controller + "-" +
+                                          setup.world + "-wind" + std::to_string(static_cast<int>(setup.wind)) +
+                                          "-vib" + (setup.vibration ? "on" : "off") + "-seed" + std::to_string(seed) +
+                                          ".lcm");
+    rc.on_message = [&log](const std::string& channel, const uint8_t* data, size_t size) {
+      log->write(bus::peek_utime(data, size).value_or(0), channel, data, size);
+    };
+  }
   rc.sim = sim::load_flight_config(util::Config::load(files.sim_dir + "/landing_" + setup.world + ".yaml"));
   rc.sim.seed = seed;
   rc.sim.wind.mean_m_s = setup.wind;
@@ -130,6 +143,7 @@ int main(int argc, char** argv) {
   app.add_option("--track-config", files.track, "aerie-track configuration");
   app.add_option("--pilot-config", files.pilot, "aerie-pilot configuration");
   app.add_flag("!--no-plots", plots, "do not run bench/landing/plot_landing.py");
+  app.add_option("--log-dir", files.log_dir, "write each run's messages as an LCM log into this folder");
   app.add_option("--log-level", log_level, "the nodes' log level (info shows every pilot transition)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));  // warn: the nodes' transitions would flood the output
@@ -146,10 +160,11 @@ int main(int argc, char** argv) {
           for (const auto& v : vibrations) setups.push_back({t, w, c, wind, v == "on"});
   if (jobs > 1) cv::setNumThreads(1);  // one core per landing
   std::filesystem::create_directories(out_dir);
+  if (!files.log_dir.empty()) std::filesystem::create_directories(files.log_dir);
   std::ofstream csv(out_dir + "/landings.csv"), desc(out_dir + "/descent.csv");
   csv << "seed,tracker,world,wind_m_s,vibration,success,touchdown_error_m,yaw_error_deg,time_s,collision,losses,"
          "reacquisitions,controller,landed,timed_out,final_state,lockstep_timeouts,pose_rmse_x_m,pose_rmse_y_m,"
-         "pose_rmse_z_m,pose_rmse_yaw_deg,sim_s,wall_s\n";
+         "pose_rmse_z_m,pose_rmse_yaw_deg,pad_refined,pad_not_found,tracker_reseeded,pad_misses,sim_s,wall_s\n";
   desc << "seed,tracker,world,wind_m_s,vibration,controller,t_s,height_m,err_x_m,err_y_m,err_z_m,err_yaw_deg\n";
   int failures = 0;
   for (const auto& s : setups) {
@@ -181,7 +196,8 @@ int main(int argc, char** argv) {
           << r.outcome.collided << ',' << r.losses << ',' << r.reacquisitions << ',' << s.controller << ','
           << r.outcome.landed << ',' << r.outcome.timed_out
           << ',' << r.final_state << ',' << r.lockstep_timeouts << ',' << r.rmse(0) << ',' << r.rmse(1) << ','
-          << r.rmse(2) << ',' << r.rmse(3) << ',' << r.sim_s << ',' << r.wall_s << '\n';
+          << r.rmse(2) << ',' << r.rmse(3) << ',' << r.pad_refined << ',' << r.pad_not_found << ','
+          << r.tracker_reseeded << ',' << r.pad_misses << ',' << r.sim_s << ',' << r.wall_s << '\n';
       for (const auto& d : r.descent)
         desc << run_seed << ',' << s.tracker << ',' << s.world << ',' << s.wind << ',' << vib << ',' << s.controller << ','
              << d.t << ',' << d.height << ',' << d.ex << ',' << d.ey << ',' << d.ez << ',' << d.eyaw_deg << '\n';

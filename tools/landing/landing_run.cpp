@@ -70,6 +70,13 @@ RunResult fly(const RunConfig& config) {
   r.losses = pilot_node.pilot().status().losses;
   r.reacquisitions = pilot_node.pilot().status().reacquisitions;
   r.lockstep_timeouts = sim_node.lockstep_timeouts();
+  r.pad_refined = track_node.counter("pad_refined");
+  r.pad_not_found = track_node.counter("pad_not_found");
+  r.tracker_reseeded = track_node.counter("tracker_reseeded");
+  for (auto miss : {track::PadMiss::EmptyWindow, track::PadMiss::NoQuad, track::PadMiss::TouchesBorder,
+                    track::PadMiss::NoMarking, track::PadMiss::Reprojection})
+    if (const int64_t n = track_node.counter("pad_miss_" + track::to_string(miss)))
+      r.pad_misses += (r.pad_misses.empty() ? "" : " ") + track::to_string(miss) + ":" + std::to_string(n);
   r.commands_refused = simulator.commands_refused();
   r.sim_s = simulator.time();
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -37,6 +37,8 @@ struct RunResult {
   std::string final_state;         // the pilot's
   int losses = 0, reacquisitions = 0;
   int64_t lockstep_timeouts = 0, target_poses = 0, commands_refused = 0;
+  int64_t pad_refined = 0, pad_not_found = 0, tracker_reseeded = 0;  // aerie-track's counters
+  std::string pad_misses;          // "reason:count ..." of the frames the pad was not found
   double sim_s = 0, wall_s = 0;
   std::vector<DescentSample> descent;
   double rmse(int axis) const;     // 0..2: x, y, z (m); 3: yaw (deg); NaN without samples

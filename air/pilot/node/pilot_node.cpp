@@ -71,6 +71,9 @@ void PilotNode::publish(const Command& c) {
     last_state_ = s.state;
     count("transitions");
   }
+  spdlog::debug("{} t {:.2f}: target ({:+.3f}, {:+.3f}) h {:.3f} yaw {:+.1f} -> v ({:+.2f}, {:+.2f}, {:+.2f}) r {:+.1f}",
+                state_name(s.state), c.utime * 1e-6, s.target_level.x(), s.target_level.y(), s.height_m, s.yaw_error_deg,
+                c.velocity.x(), c.velocity.y(), c.velocity.z(), c.yaw_rate_deg_s);
   aerie::control_cmd_t m{};
   m.utime = c.utime;
   m.seq = cmd_seq_++;

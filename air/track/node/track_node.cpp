@@ -380,11 +380,21 @@ std::optional<PadObservation> TrackNode::refine(const TrackState& s) {
   const cv::Rect2d box = s.box();
   const double w = std::max(box.width, last_pad_box_.width) * (1 + 2 * opt_.search_margin);
   const double h = std::max(box.height, last_pad_box_.height) * (1 + 2 * opt_.search_margin);
-  const cv::Rect2d search(s.pose.x - w / 2, s.pose.y - h / 2, w, h);
+  // Around the tracker first; then around the pad's last place (the tracker may have drifted
+  // off it); then the whole image.
+  std::vector<cv::Rect2d> windows{{s.pose.x - w / 2, s.pose.y - h / 2, w, h}};
+  if (last_pad_box_.area() > 0) {
+    const cv::Point2d c = (last_pad_box_.tl() + last_pad_box_.br()) * 0.5;
+    windows.emplace_back(c.x - w / 2, c.y - h / 2, w, h);
+  }
+  windows.emplace_back(0, 0, last_frame_.cols, last_frame_.rows);
   PadMiss miss = PadMiss::None;
   std::optional<PadObservation> pad;
   try {
-    pad = observe_pad(last_frame_, search, *last_camera_, {opt_.target.width_m, opt_.pad_border}, {}, &miss);
+    for (size_t i = 0; i < windows.size() && !pad; ++i) {
+      pad = observe_pad(last_frame_, windows[i], *last_camera_, {opt_.target.width_m, opt_.pad_border}, {}, &miss);
+      if (pad && i > 0) count("pad_found_outside_track");
+    }
   } catch (const std::exception& e) {  // e.g. a configured camera of another size than the frames
     count("pad_errors");
     fail(opt_.pose_channel + ": " + e.what());
