@@ -291,6 +291,7 @@ void TrackNode::start_tracker(const std::string& name, const util::Config& param
   tracker_params_ = params;
   last_box_ = box;
   last_pad_box_ = {};
+  last_pad_yaw_.reset();
 }
 
 namespace {
@@ -411,6 +412,7 @@ std::optional<PadObservation> TrackNode::refine(const TrackState& s) {
     count("tracker_reseeded");
   }
   last_pad_box_ = pad->box;
+  last_pad_yaw_ = pad->yaw;
   return pad;
 }
 
@@ -461,7 +463,9 @@ void TrackNode::publish(const Frame& frame, const TrackState* s, double ms, cons
   if (s && !s->lost && opt_.target.width_m > 0 && last_camera_) {
     try {
       // The refined pad when found (yaw modulo pi, absolute), else the box-based estimate.
-      const TargetPose p = pad ? TargetPose{pad->position, pad->yaw} : target_pose(*s, *last_camera_, opt_.target);
+      TargetPose p = pad ? TargetPose{pad->position, pad->yaw} : target_pose(*s, *last_camera_, opt_.target);
+      // A box tells nothing of a square pad's orientation: keep the last refined one.
+      if (!pad && opt_.target_shape == TargetShape::Square && last_pad_yaw_) p.yaw = *last_pad_yaw_;
       aerie::target_pose_t tp{};
       tp.utime = m.utime;
       tp.seq = pose_seq_++;

@@ -120,6 +120,7 @@ class TrackNode {
   std::optional<camera::CameraModel> last_camera_;
   cv::Rect2d last_box_;
   cv::Rect2d last_pad_box_;  // of the last refined pad (empty: none since the last INIT)
+  std::optional<double> last_pad_yaw_;  // its yaw: the box alone has no pad orientation
   int64_t frames_seen_ = 0, seq_ = 0, pose_seq_ = 0;
   bool gt_init_done_ = false;
   std::thread worker_;
