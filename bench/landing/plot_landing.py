@@ -1,7 +1,8 @@
 #!/usr/bin/python3
-"""Plots of aerie-bench-landing's output: touchdown scatter, success rate against wind,
-TARGET_POSE error along the descent.   plot_landing.py DIR  (reads DIR/landings.csv and
-DIR/descent.csv, writes DIR/touchdown.png, DIR/success_vs_wind.png, DIR/descent_error.png)"""
+"""Plots and table of aerie-bench-landing's output: touchdown scatter, success rate against
+wind, TARGET_POSE error along the descent, one markdown row per configuration.
+   plot_landing.py DIR  (reads DIR/landings.csv and DIR/descent.csv, writes DIR/touchdown.png,
+   DIR/success_vs_wind.png, DIR/descent_error.png and DIR/summary.md)"""
 import csv
 import sys
 from collections import defaultdict
@@ -21,9 +22,38 @@ def key(r):
     return f"{r['tracker']} {r['controller']} {r['world']} vib {r['vibration']}"
 
 
+def table(landings, descent):
+    """One markdown row per configuration (tracker, controller, world, wind, vibration)."""
+    conf = lambda r: (r["tracker"], r["controller"], r["world"], float(r["wind_m_s"]), r["vibration"])
+    runs, desc = defaultdict(list), defaultdict(list)
+    for r in landings:
+        runs[conf(r)].append(r)
+    for r in descent:
+        desc[conf(r)].append(r)
+    out = ["| tracker | controller | world | wind (m/s) | vibration | runs | success | touchdown error mean / p95 (cm) "
+           "| time (s) | losses / run | TARGET_POSE RMSE x / y / z (cm), yaw (deg) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for k in sorted(runs):
+        rs = runs[k]
+        ok = sum(int(r["success"]) for r in rs)
+        landed = [r for r in rs if r["landed"] == "1"]
+        err = sorted(100 * float(r["touchdown_error_m"]) for r in landed)
+        p95 = err[min(len(err) - 1, max(0, -(-95 * len(err) // 100) - 1))] if err else float("nan")
+        mean = lambda v: sum(v) / len(v) if v else float("nan")
+        rmse = lambda col: mean([float(r[col]) ** 2 for r in desc[k]]) ** 0.5
+        out.append(f"| {k[0]} | {k[1]} | {k[2]} | {k[3]:g} | {k[4]} | {len(rs)} | {ok}/{len(rs)} ({100 * ok / len(rs):.0f} %) "
+                   f"| {mean(err):.1f} / {p95:.1f} | {mean([float(r['time_s']) for r in landed]):.1f} "
+                   f"| {mean([int(r['losses']) for r in rs]):.2f} "
+                   f"| {100 * rmse('err_x_m'):.2f} / {100 * rmse('err_y_m'):.2f} / {100 * rmse('err_z_m'):.2f}, "
+                   f"{rmse('err_yaw_deg'):.2f} |")
+    return "\n".join(out) + "\n"
+
+
 def main(out):
     landings = rows(f"{out}/landings.csv")
     descent = rows(f"{out}/descent.csv")
+    with open(f"{out}/summary.md", "w") as f:
+        f.write(table(landings, descent))
 
     # Touchdown points relative to the pad (error magnitude and yaw error), per configuration.
     fig, ax = plt.subplots(figsize=(6, 5))

@@ -54,6 +54,7 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
       .known("vehicle")
       .known("imu")
       .known("down_camera")
+      .known("calibration_error")
       .known("stereo_rig")
       .known("wind")
       .known("vibration")
@@ -65,6 +66,10 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
   f.imu = load_imu(cfg.section("imu"));
   f.down_camera = load_rig_config(cfg.section("down_camera"), FlightSimConfig::down_rig());
   f.stereo_rig = load_rig_config(cfg.section("stereo_rig"));
+  using C = CalibrationError;
+  util::SectionReader<C>(cfg.section("calibration_error"), f.calibration_error)("focal_rel", &C::focal_rel)(
+      "principal_px", &C::principal_px)
+      .finish();
   using W = WindParams;
   util::SectionReader<W>(cfg.section("wind"), f.wind)("mean_m_s", &W::mean_m_s)("gust_std_m_s", &W::gust_std_m_s)(
       "gust_time_constant_s", &W::gust_time_constant_s)

@@ -50,6 +50,8 @@ void FlightSimConfig::validate() const {
   need(placement.exposure_jitter >= 0 && placement.exposure_jitter < 0.9, "placement.exposure_jitter must be in [0, 0.9)");
   need(max_time_s > 0, "max_time_s must be > 0");
   need(down_camera.width > 0 && down_camera.height > 0, "down_camera size must be > 0");
+  need(calibration_error.focal_rel >= 0 && calibration_error.focal_rel < 0.2 && calibration_error.principal_px >= 0,
+       "calibration_error: focal_rel must be in [0, 0.2), principal_px >= 0");
 }
 
 // The world of layout `layout` (0, then 1, 2, ... when a layout has no free take-off
@@ -125,6 +127,13 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   fwd.noise_seed = mix_seed(cfg_.seed, 7005);
   down_ = StereoRenderer(world_, down);
   forward_ = StereoRenderer(world_, fwd);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  down_calibration_ = down_.intrinsics();
+  const double focal = 1.0 + cfg_.calibration_error.focal_rel * n01(rng_);
+  down_calibration_.fx *= focal;
+  down_calibration_.fy *= focal;
+  down_calibration_.cx += cfg_.calibration_error.principal_px * n01(rng_);
+  down_calibration_.cy += cfg_.calibration_error.principal_px * n01(rng_);
   T_body_down_ = body_to_left(down);
   T_body_left_ = body_to_left(fwd);
 
@@ -137,7 +146,6 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   // Wind: steady part from a drawn direction, gusts from their stationary distribution.
   const double theta = 2 * kPi * u01(rng_);
   wind_mean_ = cfg_.wind.mean_m_s * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
-  std::normal_distribution<double> n01(0.0, 1.0);
   gust_ = cfg_.wind.gust_std() * Eigen::Vector3d(n01(rng_), n01(rng_), 0.0);
   for (auto& axis : vib_phase_) axis = {2 * kPi * u01(rng_), 2 * kPi * u01(rng_), 0.85, 1.15};
 }

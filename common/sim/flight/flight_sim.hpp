@@ -48,11 +48,19 @@ struct PlacementParams {
   double exposure_jitter = 0.15;   // lighting: camera exposure drawn in [1 - j, 1 + j]
 };
 
+// The calibration the down camera's images carry differs from the true intrinsics by a
+// seeded error, as a real calibration does (1 sigma values).
+struct CalibrationError {
+  double focal_rel = 0.005;     // relative error of fx and fy (0.5 %)
+  double principal_px = 1.0;    // error of cx and cy (px)
+};
+
 struct FlightSimConfig {
   WorldConfig world;
   MultirotorParams vehicle = MultirotorParams::by_name("ardrone");
   ImuParams imu;
   RigConfig down_camera = down_rig();
+  CalibrationError calibration_error;  // of the intrinsics published with CAM_DOWN
   bool stereo = false;             // also render the forward stereo pair
   RigConfig stereo_rig;
   double frame_rate_hz = 20.0;
@@ -138,6 +146,8 @@ class FlightSim {
   const FlightOutcome& outcome() const { return outcome_; }
   const FlightSimConfig& config() const { return cfg_; }
   Intrinsics down_intrinsics() const { return down_.intrinsics(); }
+  // What the down camera's calibration says (the true intrinsics plus the seeded error).
+  const Intrinsics& down_calibration() const { return down_calibration_; }
   Intrinsics stereo_intrinsics() const { return forward_.intrinsics(); }
   int64_t commands_applied() const { return applied_; }
   int64_t commands_refused() const { return refused_; }
@@ -158,6 +168,7 @@ class FlightSim {
   FlightSimConfig cfg_;
   World world_;
   StereoRenderer down_, forward_;
+  Intrinsics down_calibration_;
   Multirotor vehicle_;
   Imu imu_;
   std::mt19937_64 rng_;

@@ -143,7 +143,7 @@ const FlightFrame& FlightSimNode::publish_next() {
     bus_.publish(opt_.stereo_channel, s);
   }
   if (!opt_.down_channel.empty())
-    bus_.publish(opt_.down_channel, image_message(f.down.left, f.utime, f.seq, "down", sim_.down_intrinsics()));
+    bus_.publish(opt_.down_channel, image_message(f.down.left, f.utime, f.seq, "down", sim_.down_calibration()));
   return frame_;
 }
 
