@@ -1,0 +1,61 @@
+// aerie-pilot's node over memq://: one CTRL_CMD per TRACK with its utime, bad inputs counted
+// and dropped, operator commands applied or refused with a count.
+#include <aerie/control_cmd_t.hpp>
+#include <aerie/pilot_cmd_t.hpp>
+#include <aerie/target_pose_t.hpp>
+#include <aerie/track_t.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "air/pilot/node/pilot_node.hpp"
+#include "air/pilot/pilot_config.hpp"
+
+using namespace aerie;
+
+TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
+  bus::Bus bus("memq://");
+  pilot::PilotNode node(bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml")));
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  auto drain = [&] {
+    while (bus.handle(0) > 0) {
+    }
+  };
+  aerie::track_t t{};
+  t.status = aerie::track_t::IDLE;
+  for (int k = 1; k <= 3; ++k) {
+    t.utime = k * 50000;
+    t.seq = k;
+    bus.publish("TRACK", t);
+    drain();
+  }
+  ASSERT_EQ(cmds.size(), 3u);
+  EXPECT_EQ(cmds.back().utime, 150000);
+  EXPECT_EQ(cmds.back().mode, aerie::control_cmd_t::TAKEOFF);
+
+  aerie::target_pose_t bad{};
+  bad.utime = 200000;
+  bad.position[0] = std::nan("");
+  bad.position[2] = 2.0;
+  bus.publish("TARGET_POSE", bad);
+  t.status = 7;  // unknown
+  t.utime = 200000;
+  bus.publish("TRACK", t);
+  aerie::pilot_cmd_t op{};
+  op.command = aerie::pilot_cmd_t::RESUME;  // not in TAKEOFF
+  op.source = "test";
+  bus.publish("PILOT_CMD", op);
+  op.command = 42;
+  bus.publish("PILOT_CMD", op);
+  op.command = aerie::pilot_cmd_t::ABORT;
+  bus.publish("PILOT_CMD", op);
+  drain();
+  EXPECT_EQ(node.counter("TARGET_POSE_refused"), 1);
+  EXPECT_EQ(node.counter("TRACK_refused"), 1);
+  EXPECT_EQ(node.counter("operator_refused"), 2);
+  EXPECT_EQ(node.counter("operator_accepted"), 1);
+  EXPECT_EQ(node.pilot().state(), pilot::State::Abort);
+  EXPECT_EQ(cmds.size(), 3u);  // the bad TRACK made no command
+}
