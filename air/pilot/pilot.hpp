@@ -49,7 +49,7 @@ struct PilotConfig {
   int settle_frames = 10;               // ... for this many frames in a row -> DESCEND
   double descent_speed_m_s = 0.35;
   double descent_gate_m = 0.3;       // the descent slows linearly to 0 at this horizontal error
-  double touchdown_height_m = 0.7;   // below this height the camera loses the pad: autopilot LAND
+  double touchdown_height_m = 1.0;   // below this height vision hands over to the autopilot LAND
   double touchdown_time_s = 3.0;     // TOUCHDOWN -> LANDED after this long
   double stale_timeout_s = 0.5;      // no tracker result for this long -> HOLD
   int loss_frames = 3;               // tracker lost this many frames in a row -> HOLD

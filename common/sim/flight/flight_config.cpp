@@ -14,7 +14,8 @@ MultirotorParams load_vehicle(const util::Config& c) {
       .known("class")("vertical_time_constant_s", &M::vertical_time_constant_s)(
           "max_horizontal_speed_m_s", &M::max_horizontal_speed_m_s)("max_vertical_speed_m_s", &M::max_vertical_speed_m_s)(
           "max_tilt_deg", &M::max_tilt_deg)("drag_per_s", &M::drag_per_s)(
-          "velocity_integral_per_s2", &M::velocity_integral_per_s2)(
+          "velocity_integral_per_s2", &M::velocity_integral_per_s2)("position_hold_per_s", &M::position_hold_per_s)(
+          "hold_drift_m_per_sqrt_s", &M::hold_drift_m_per_sqrt_s)(
           "attitude_time_constant_s", &M::attitude_time_constant_s)("takeoff_height_m", &M::takeoff_height_m)(
           "takeoff_speed_m_s", &M::takeoff_speed_m_s)("land_speed_m_s", &M::land_speed_m_s)("radius_m", &M::radius_m)(
           "max_touchdown_speed_m_s", &M::max_touchdown_speed_m_s)

@@ -140,7 +140,7 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   MultirotorState start;
   start.position = *start_point;
   start.yaw = cfg_.placement.start_yaw_deg < 1e9 ? cfg_.placement.start_yaw_deg * kDeg : 2 * kPi * u01(rng_) - kPi;
-  vehicle_ = Multirotor(cfg_.vehicle, start);
+  vehicle_ = Multirotor(cfg_.vehicle, start, mix_seed(cfg_.seed, 7006));
   q_prev_ = start.pose().rotation();
 
   // Wind: steady part from a drawn direction, gusts from their stationary distribution.

@@ -50,8 +50,10 @@ void MultirotorParams::validate() const {
   need(base.max_yaw_rate_deg_s > 0 && max_horizontal_speed_m_s > 0 && max_vertical_speed_m_s > 0,
        "speed and yaw-rate limits must be > 0");
   need(max_tilt_deg > 0 && max_tilt_deg < 60, "max_tilt_deg must be in (0, 60)");
-  need(drag_per_s >= 0 && base.command_delay_s >= 0 && velocity_integral_per_s2 >= 0,
-       "drag_per_s, velocity_integral_per_s2 and command_delay_s must be >= 0");
+  need(drag_per_s >= 0 && base.command_delay_s >= 0 && velocity_integral_per_s2 >= 0 && position_hold_per_s >= 0 &&
+           hold_drift_m_per_sqrt_s >= 0,
+       "drag_per_s, velocity_integral_per_s2, position_hold_per_s, hold_drift_m_per_sqrt_s and command_delay_s "
+       "must be >= 0");
   need(takeoff_height_m > 0 && takeoff_speed_m_s > 0 && land_speed_m_s > 0, "take-off and landing figures must be > 0");
   need(radius_m > 0 && max_touchdown_speed_m_s > 0, "radius_m and max_touchdown_speed_m_s must be > 0");
 }
@@ -64,7 +66,8 @@ geometry::SE3 MultirotorState::pose() const {
   return {R, position};
 }
 
-Multirotor::Multirotor(const MultirotorParams& params, const MultirotorState& initial) : p_(params), s_(initial) {
+Multirotor::Multirotor(const MultirotorParams& params, const MultirotorState& initial, uint64_t seed)
+    : p_(params), s_(initial), rng_(seed) {
   p_.validate();
   takeoff_z_ = s_.position.z();
 }
@@ -76,9 +79,15 @@ void Multirotor::command(double t_s, const AutopilotCommand& cmd) {
 void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
   if (!(dt > 0)) throw std::invalid_argument("Multirotor::step: dt must be > 0");
   while (!pending_.empty() && pending_.front().first <= t_s + 1e-9) {
-    active_ = pending_.front().second;
+    const bool holds = active_.mode == AutopilotCommand::Mode::Hover || active_.mode == AutopilotCommand::Mode::Land;
+    const auto next = pending_.front().second;
     pending_.pop_front();
+    // A holding mode keeps the point where it began (a repeated one keeps the first).
+    if (next.mode != active_.mode || !holds) hold_ = s_.position.head<2>() + odometry_error_;
+    active_ = next;
   }
+  std::normal_distribution<double> n01(0.0, 1.0);
+  odometry_error_ += p_.hold_drift_m_per_sqrt_s * std::sqrt(dt) * Eigen::Vector2d(n01(rng_), n01(rng_));
   using Mode = AutopilotCommand::Mode;
   if (active_.mode == Mode::Takeoff && !s_.armed) {
     s_.armed = true;
@@ -98,8 +107,11 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
   auto to_world = [&](const Eigen::Vector3d& v) { return Eigen::Vector3d(c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()); };
   Eigen::Vector3d v_cmd = Eigen::Vector3d::Zero();
   double yaw_rate_cmd = 0;  // rad/s, ENU
+  const Eigen::Vector2d hold_velocity = p_.position_hold_per_s * (hold_ - (s_.position.head<2>() + odometry_error_));
   switch (active_.mode) {
-    case Mode::Hover: break;
+    case Mode::Hover:
+      v_cmd.head<2>() = hold_velocity;
+      break;
     case Mode::Velocity:
       v_cmd = to_world(active_.velocity);
       yaw_rate_cmd = -active_.yaw_rate_deg_s * kDeg;
@@ -111,6 +123,7 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
     }
     case Mode::Land:
       v_cmd = to_world({active_.velocity.x(), active_.velocity.y(), 0.0});
+      v_cmd.head<2>() += hold_velocity;
       v_cmd.z() = -p_.land_speed_m_s;
       break;
   }

@@ -5,7 +5,9 @@
 // vertical axis), after a command latency. Wind acts through linear rotor drag on the
 // air-relative velocity; the autopilot's velocity loops have integral action (as PX4's
 // and ArduPilot's do), so a steady wind is rejected within seconds and gusts push the
-// vehicle until the loops, and the pilot's outer loop, correct them.
+// vehicle until the loops, and the pilot's outer loop, correct them. HOVER and LAND hold
+// the position where they began on the autopilot's own odometry (the AR.Drone's optical
+// flow), which drifts as a random walk.
 // Roll and pitch follow the horizontal thrust the motion needs (small-angle multirotor
 // kinematics, with the attitude loop's own lag), which tilts the cameras and shows in
 // the IMU.
@@ -17,6 +19,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <random>
 #include <string>
 
 #include "common/geometry/se3.hpp"
@@ -32,6 +35,8 @@ struct MultirotorParams {
   double max_tilt_deg = 25.0;         // horizontal acceleration limit = g tan(max tilt)
   double drag_per_s = 0.3;            // linear rotor drag: a = drag * (wind - v)
   double velocity_integral_per_s2 = 1.0;  // integral action of the autopilot's velocity loops (rejects steady wind)
+  double position_hold_per_s = 1.0;   // HOVER and LAND hold the position where they began (gain, 1/s) ...
+  double hold_drift_m_per_sqrt_s = 0.01;  // ... on the autopilot's own odometry (optical flow), which drifts
   double attitude_time_constant_s = 0.08;  // roll/pitch follow the thrust direction
   double takeoff_height_m = 2.5;      // TAKEOFF climbs to this height above the take-off point
   double takeoff_speed_m_s = 0.6;
@@ -68,7 +73,7 @@ struct MultirotorState {
 
 class Multirotor {
  public:
-  Multirotor(const MultirotorParams& params, const MultirotorState& initial);
+  Multirotor(const MultirotorParams& params, const MultirotorState& initial, uint64_t seed = 1);
 
   // Queues a command issued at time t_s; it acts from t_s + command latency on.
   void command(double t_s, const AutopilotCommand& cmd);
@@ -91,6 +96,9 @@ class Multirotor {
   AutopilotCommand active_;
   double takeoff_z_ = 0.0;
   Eigen::Vector3d velocity_integral_ = Eigen::Vector3d::Zero();  // m/s^2
+  Eigen::Vector2d hold_ = Eigen::Vector2d::Zero();                // HOVER/LAND position to hold
+  Eigen::Vector2d odometry_error_ = Eigen::Vector2d::Zero();      // the autopilot's position estimate - truth
+  std::mt19937_64 rng_;
 };
 
 }  // namespace aerie::sim

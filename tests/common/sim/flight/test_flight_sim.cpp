@@ -98,6 +98,26 @@ TEST(FlightSim, ATakeoffAndALandOnThePadScoreASuccess) {
   EXPECT_NEAR(s.yaw_error_deg, 0.0, 1.0);
 }
 
+TEST(FlightSim, LandHoldsItsPositionInAGustyWind) {
+  double sum = 0;
+  for (uint64_t seed : {1, 2, 3, 4, 5}) {
+    FlightSimConfig cfg = small_room(seed);
+    cfg.wind.mean_m_s = 2;
+    FlightSim sim(cfg);
+    sim.step();
+    sim.command(mode(kTakeoff));
+    fly_until(sim, 8.0);
+    const Eigen::Vector2d before = sim.vehicle().state().position.head<2>();
+    sim.command(mode(kLand));
+    fly_until(sim, 16.0);
+    ASSERT_TRUE(sim.outcome().landed);
+    const double moved = (sim.outcome().touchdown_position.head<2>() - before).norm();
+    EXPECT_LT(moved, 0.25) << "seed " << seed;  // 2 m/s wind with 0.6 m/s gusts (2 s) over a 3 m descent
+    sum += moved;
+  }
+  EXPECT_LT(sum / 5, 0.12);
+}
+
 TEST(FlightSim, FlyingIntoAWallIsACollisionNamedWithWhereItHappened) {
   FlightSim sim(small_room());
   sim.step();

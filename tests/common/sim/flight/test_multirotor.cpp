@@ -16,6 +16,7 @@ constexpr double kDt = 0.005;
 
 Multirotor airborne(MultirotorParams p = MultirotorParams::by_name("ardrone")) {
   p.velocity_integral_per_s2 = 0;  // the pure first-order loops, to check their time constants
+  p.hold_drift_m_per_sqrt_s = 0;
   MultirotorState s;
   s.position = {0, 0, 2};
   s.armed = true;
