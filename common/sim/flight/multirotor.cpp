@@ -70,6 +70,7 @@ Multirotor::Multirotor(const MultirotorParams& params, const MultirotorState& in
     : p_(params), s_(initial), rng_(seed) {
   p_.validate();
   takeoff_z_ = s_.position.z();
+  hold_ = s_.position.head<2>();
 }
 
 void Multirotor::command(double t_s, const AutopilotCommand& cmd) {
@@ -79,7 +80,7 @@ void Multirotor::command(double t_s, const AutopilotCommand& cmd) {
 void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
   if (!(dt > 0)) throw std::invalid_argument("Multirotor::step: dt must be > 0");
   while (!pending_.empty() && pending_.front().first <= t_s + 1e-9) {
-    const bool holds = active_.mode == AutopilotCommand::Mode::Hover || active_.mode == AutopilotCommand::Mode::Land;
+    const bool holds = active_.mode != AutopilotCommand::Mode::Velocity;
     const auto next = pending_.front().second;
     pending_.pop_front();
     // A holding mode keeps the point where it began (a repeated one keeps the first).
@@ -117,6 +118,7 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
       yaw_rate_cmd = -active_.yaw_rate_deg_s * kDeg;
       break;
     case Mode::Takeoff: {
+      v_cmd.head<2>() = hold_velocity;
       const double target_z = takeoff_z_ + p_.takeoff_height_m;
       v_cmd.z() = std::clamp(1.5 * (target_z - s_.position.z()), -p_.takeoff_speed_m_s, p_.takeoff_speed_m_s);
       break;

@@ -5,7 +5,7 @@
 // vertical axis), after a command latency. Wind acts through linear rotor drag on the
 // air-relative velocity; the autopilot's velocity loops have integral action (as PX4's
 // and ArduPilot's do), so a steady wind is rejected within seconds and gusts push the
-// vehicle until the loops, and the pilot's outer loop, correct them. HOVER and LAND hold
+// vehicle until the loops, and the pilot's outer loop, correct them. TAKEOFF, HOVER and LAND hold
 // the position where they began on the autopilot's own odometry (the AR.Drone's optical
 // flow), which drifts as a random walk.
 // Roll and pitch follow the horizontal thrust the motion needs (small-angle multirotor
@@ -35,7 +35,7 @@ struct MultirotorParams {
   double max_tilt_deg = 25.0;         // horizontal acceleration limit = g tan(max tilt)
   double drag_per_s = 0.3;            // linear rotor drag: a = drag * (wind - v)
   double velocity_integral_per_s2 = 1.0;  // integral action of the autopilot's velocity loops (rejects steady wind)
-  double position_hold_per_s = 1.0;   // HOVER and LAND hold the position where they began (gain, 1/s) ...
+  double position_hold_per_s = 1.0;   // TAKEOFF, HOVER and LAND hold the position where they began (gain, 1/s) ...
   double hold_drift_m_per_sqrt_s = 0.01;  // ... on the autopilot's own odometry (optical flow), which drifts
   double attitude_time_constant_s = 0.08;  // roll/pitch follow the thrust direction
   double takeoff_height_m = 2.5;      // TAKEOFF climbs to this height above the take-off point
