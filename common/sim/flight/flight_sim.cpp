@@ -150,6 +150,11 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   for (auto& axis : vib_phase_) axis = {2 * kPi * u01(rng_), 2 * kPi * u01(rng_), 0.85, 1.15};
 }
 
+void FlightSim::set_start_utime(int64_t utime) {
+  if (frame_ >= 0) throw std::logic_error("FlightSim::set_start_utime after the first step");
+  cfg_.start_utime = utime;
+}
+
 int64_t FlightSim::utime_of(double t) const { return cfg_.start_utime + std::llround(t * 1e6); }
 
 double FlightSim::support_height(const Eigen::Vector3d& p) const {

@@ -138,6 +138,8 @@ class FlightSim {
   // reason when refused ("" when applied).
   std::string command(const CommandInput& cmd);
 
+  // The utime of frame 0; only before the first step (real time: the wall clock at start).
+  void set_start_utime(int64_t utime);
   double time() const { return t_; }
   int64_t frame() const { return frame_; }
   int64_t utime_of(double t) const;

@@ -51,8 +51,6 @@ int main(int argc, char** argv) {
     if (wind >= 0) fc.wind.mean_m_s = wind;
     if (!vibration.empty()) fc.vibration.enabled = vibration == "on";
     if (stereo) fc.stereo = true;
-    // Real time: message time is wall time, so that latency tools and other nodes' clocks agree.
-    if (mode == "realtime" && fc.start_utime == 0) fc.start_utime = util::wall_utime();
     sim::FlightSim simulator(fc);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "flightsim");
@@ -65,6 +63,8 @@ int main(int argc, char** argv) {
     spdlog::info("{} world, seed {}, wind {} m/s, vibration {}, {} at {} Hz", fc.world.kind, fc.seed, fc.wind.mean_m_s,
                  fc.vibration.enabled ? "on" : "off", lockstep ? "lock-step" : "real time", fc.frame_rate_hz);
     const int64_t wall0 = util::wall_utime();
+    // Real time: message time is wall time, so that latency tools and other nodes' clocks agree.
+    if (!lockstep && fc.start_utime == 0) simulator.set_start_utime(wall0);
     double ended_at = -1;
     while (!bus::stop_requested()) {
       const auto& f = node.publish_next();
