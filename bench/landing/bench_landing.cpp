@@ -19,7 +19,6 @@
 #include <mutex>
 #include <numeric>
 #include <opencv2/core.hpp>
-#include <sstream>
 #include <thread>
 
 #include "air/pilot/pilot_config.hpp"
@@ -42,32 +41,39 @@ struct Files {
   std::string sim_dir, track, pilot, log_dir;
 };
 
-landing::RunResult fly(const Setup& setup, uint64_t seed, const Files& files) {
+// The simulator's and the pilot's configuration of a setup, read once (plain data, shared by
+// the runs); each run sets its seed. The tracker's options hold YAML nodes, which are not
+// safe to share between threads: each run reads them itself.
+landing::RunConfig setup_config(const Setup& setup, const Files& files) {
   landing::RunConfig rc;
-  std::unique_ptr<logio::Writer> log;
-  if (!files.log_dir.empty()) {
-    // Every message of the run, stamped with its own (simulation) time: lcm-logplayer and
-    // aerie-viewer replay it like a flight log.
-    log = std::make_unique<logio::Writer>(files.log_dir + "/" + setup.tracker + "-" + setup.controller + "-" +
-                                          setup.world + "-wind" + std::to_string(static_cast<int>(setup.wind)) +
-                                          "-vib" + (setup.vibration ? "on" : "off") + "-seed" + std::to_string(seed) +
-                                          ".lcm");
-    rc.on_message = [&log](const std::string& channel, const uint8_t* data, size_t size) {
-      log->write(bus::peek_utime(data, size).value_or(0), channel, data, size);
-    };
-  }
   rc.sim = sim::load_flight_config(util::Config::load(files.sim_dir + "/landing_" + setup.world + ".yaml"));
-  rc.sim.seed = seed;
   rc.sim.wind.mean_m_s = setup.wind;
   rc.sim.vibration.enabled = setup.vibration;
-  rc.track = track::node_options(util::Config::load(files.track));
-  rc.track.tracker = setup.tracker;
-  rc.track.seed = seed;
   YAML::Node pilot_yaml = YAML::LoadFile(files.pilot);
   pilot_yaml["controller"] = setup.controller;
   YAML::Emitter out;
   out << pilot_yaml;
   rc.pilot = pilot::load_pilot_config(util::Config::parse(out.c_str(), files.pilot));
+  return rc;
+}
+
+landing::RunResult fly(const Setup& setup, landing::RunConfig rc, uint64_t seed, const Files& files) {
+  rc.sim.seed = seed;
+  rc.track = track::node_options(util::Config::load(files.track));
+  rc.track.tracker = setup.tracker;
+  rc.track.seed = seed;
+  const std::string& log_dir = files.log_dir;
+  std::unique_ptr<logio::Writer> log;
+  if (!log_dir.empty()) {
+    // Every message of the run, stamped with its own (simulation) time: lcm-logplayer and
+    // aerie-viewer replay it like a flight log.
+    log = std::make_unique<logio::Writer>(log_dir + "/" + setup.tracker + "-" + setup.controller + "-" + setup.world +
+                                          "-wind" + std::to_string(static_cast<int>(setup.wind)) + "-vib" +
+                                          (setup.vibration ? "on" : "off") + "-seed" + std::to_string(seed) + ".lcm");
+    rc.on_message = [&log](const std::string& channel, const uint8_t* data, size_t size) {
+      log->write(bus::peek_utime(data, size).value_or(0), channel, data, size);
+    };
+  }
   return landing::fly(rc);
 }
 
@@ -168,13 +174,14 @@ int main(int argc, char** argv) {
   desc << "seed,tracker,world,wind_m_s,vibration,controller,t_s,height_m,err_x_m,err_y_m,err_z_m,err_yaw_deg\n";
   int failures = 0;
   for (const auto& s : setups) {
+    const landing::RunConfig config = setup_config(s, files);
     std::vector<landing::RunResult> results(static_cast<size_t>(runs));
     std::atomic<int> next{0};
     std::mutex err_mutex;
     auto worker = [&] {
       for (int i = next++; i < runs; i = next++) {
         try {
-          results[static_cast<size_t>(i)] = fly(s, seed + static_cast<uint64_t>(i), files);
+          results[static_cast<size_t>(i)] = fly(s, config, seed + static_cast<uint64_t>(i), files);
         } catch (const std::exception& e) {
           std::lock_guard lk(err_mutex);
           std::fprintf(stderr, "aerie-bench-landing: run with seed %llu failed: %s\n",

@@ -295,10 +295,8 @@ FlightFrame FlightSim::step() {
   const geometry::SE3 T_world_body = f.vehicle.pose();
   f.T_world_down = T_world_body * T_body_down_ * vibration(t_);
   f.down = down_.render_mono(f.T_world_down, f.utime, f.seq);
-  if (cfg_.stereo) {
-    f.T_world_left = T_world_body * T_body_left_ * vibration(t_ + 0.37);
-    f.stereo = forward_.render(f.T_world_left, f.utime, f.seq);
-  }
+  f.T_world_left = T_world_body * T_body_left_ * vibration(t_ + 0.37);
+  if (cfg_.stereo) f.stereo = forward_.render(f.T_world_left, f.utime, f.seq);
   f.target = target_in(f.T_world_down);
   return f;
 }

@@ -122,7 +122,7 @@ struct FlightFrame {
   StereoFrame down;                // left = the down camera image; target_* = GT of the pad
   std::optional<StereoFrame> stereo;
   geometry::SE3 T_world_down;      // with vibration
-  geometry::SE3 T_world_left;      // forward left camera (when stereo)
+  geometry::SE3 T_world_left;      // forward left camera (with vibration; rendered when stereo)
   MultirotorState vehicle;
   Eigen::Vector3d wind = Eigen::Vector3d::Zero();
   TargetTruth target;              // in the down camera

@@ -71,7 +71,7 @@ const FlightFrame& FlightSimNode::publish_next() {
     bus_.publish(opt_.imu_channel, m);
   }
   if (!opt_.gt_pose_channel.empty()) {
-    const geometry::SE3 T = f.vehicle.pose() * body_to_left(sim_.config().stereo_rig);
+    const geometry::SE3& T = f.T_world_left;
     aerie::gt_pose_t p{};
     p.utime = f.utime;
     p.seq = f.seq;
