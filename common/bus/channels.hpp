@@ -15,6 +15,7 @@ inline constexpr const char* kTrack = "TRACK";           // aerie.track_t
 inline constexpr const char* kTrackCmd = "TRACK_CMD";    // aerie.track_cmd_t
 inline constexpr const char* kTargetPose = "TARGET_POSE";  // aerie.target_pose_t
 inline constexpr const char* kVoPose = "VO_POSE";        // aerie.pose_t
+inline constexpr const char* kNavState = "NAV_STATE";    // aerie.nav_state_t (VO + IMU EKF)
 inline constexpr const char* kVoDepth = "VO_DEPTH";      // aerie.spherical_depth_t
 inline constexpr const char* kMapOctomap = "MAP_OCTOMAP";  // aerie.octomap_t
 inline constexpr const char* kMapQuery = "MAP_QUERY";    // aerie.map_query_t

@@ -1,0 +1,24 @@
+#pragma once
+// config/nav.yaml -> NavConfig (every key documented there; unknown keys are rejected naming
+// the file and the key; values are checked by EskfParams::validate()).
+#include <string>
+
+#include "air/nav/eskf.hpp"
+#include "common/util/config.hpp"
+
+namespace aerie::nav {
+
+struct NavConfig {
+  EskfParams eskf;
+  double publish_rate_hz = 0.0;  // NAV_STATE rate in message time; 0 = every accepted IMU sample
+};
+
+NavConfig load_nav_config(const util::Config& cfg);
+// The default camera.T_body_cam: the simulator's forward stereo rig with its defaults (left
+// camera at +0.06 m along body y, optical axis along body x pitched 20 deg down; docs/sim.md).
+geometry::SE3 sim_forward_rig_T_body_cam();
+// A 4x4 row-major homogeneous transform (16 numbers, EuRoC's T_BS layout) as an SE3; throws
+// naming `what` when it is not 16 finite numbers with an orthonormal rotation and last row 0 0 0 1.
+geometry::SE3 se3_from_row_major(const std::vector<double>& m, const std::string& what);
+
+}  // namespace aerie::nav

@@ -1,0 +1,46 @@
+#pragma once
+// aerie-nav as a class: IMU (aerie.imu_t) and VO_POSE (aerie.pose_t) in, NAV_STATE
+// (aerie.nav_state_t) out, one per accepted IMU sample or at publish_rate_hz (message time).
+// Bad messages are refused by the filter or here with a reason, counted and logged; the
+// filter never sees a malformed one.
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "air/nav/eskf.hpp"
+#include "air/nav/nav_config.hpp"
+#include "common/bus/bus.hpp"
+#include "common/bus/channels.hpp"
+#include "common/bus/status.hpp"
+
+namespace aerie::nav {
+
+struct NavNodeOptions {
+  std::string imu_channel = channels::kImu;
+  std::string vo_channel = channels::kVoPose;
+  std::string state_channel = channels::kNavState;
+};
+
+class NavNode {
+ public:
+  NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options = {});
+  void report(bus::StatusReporter& status) const;
+  const Eskf& filter() const { return eskf_; }
+  int64_t counter(const std::string& name) const;
+
+ private:
+  void publish();
+  void refused(const std::string& what, const std::string& why);
+
+  bus::Bus& bus_;
+  NavConfig cfg_;
+  NavNodeOptions opt_;
+  Eskf eskf_;
+  std::map<std::string, int64_t> counters_;
+  std::string last_error_;
+  NavStatus last_status_ = NavStatus::Initialising;
+  int64_t seq_ = 0;
+  int64_t last_publish_utime_ = INT64_MIN;
+};
+
+}  // namespace aerie::nav

@@ -1,0 +1,167 @@
+// aerie-nav's node over memq://: one NAV_STATE per IMU sample, INITIALISING until the static
+// alignment, VO poses applied, bad inputs refused and counted, an outage reported; and
+// config/nav.yaml: it documents the defaults, unknown keys and bad values are refused.
+#include <aerie/imu_t.hpp>
+#include <aerie/nav_state_t.hpp>
+#include <aerie/pose_t.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "air/nav/nav_config.hpp"
+#include "air/nav/node/nav_node.hpp"
+
+using namespace aerie;
+
+namespace {
+
+aerie::imu_t still_imu(int64_t utime) {
+  aerie::imu_t m{};
+  m.utime = utime;
+  m.seq = utime / 5000;
+  m.angular_velocity[0] = 0.003;  // a gyro bias
+  m.angular_velocity[1] = -0.002;
+  m.angular_velocity[2] = 0.001;
+  m.linear_acceleration[2] = 9.81;
+  m.orientation[0] = 1.0;
+  return m;
+}
+
+}  // namespace
+
+TEST(NavNode, PublishesStateAppliesVoAndCountsBadInputs) {
+  bus::Bus bus("memq://");
+  nav::NavConfig cfg = nav::load_nav_config(util::Config::load(AERIE_SOURCE_DIR "/config/nav.yaml"));
+  nav::NavNode node(bus, cfg);
+  std::vector<aerie::nav_state_t> states;
+  bus.subscribe<aerie::nav_state_t>("NAV_STATE", [&](const aerie::nav_state_t& m, const bus::ReceiveInfo&) { states.push_back(m); });
+  auto drain = [&] {
+    while (bus.handle(0) > 0) {
+    }
+  };
+  int64_t t = 1'000'000;
+  for (int k = 0; k < 150; ++k) {  // 0.75 s: still aligning
+    bus.publish("IMU", still_imu(t += 5000));
+    drain();
+  }
+  ASSERT_EQ(states.size(), 150u);
+  EXPECT_EQ(states.back().status, aerie::nav_state_t::INITIALISING);
+  EXPECT_NE(states.back().reason.find("static alignment"), std::string::npos) << states.back().reason;
+  for (int k = 0; k < 60; ++k) {  // past the 1 s window
+    bus.publish("IMU", still_imu(t += 5000));
+    drain();
+  }
+  ASSERT_EQ(states.size(), 210u);
+  const aerie::nav_state_t& s = states.back();
+  EXPECT_EQ(s.status, aerie::nav_state_t::OK);
+  EXPECT_EQ(s.utime, t);
+  EXPECT_NEAR(s.gyro_bias[0], 0.003, 1e-12);
+  EXPECT_NEAR(s.gyro_bias[1], -0.002, 1e-12);
+  EXPECT_NEAR(s.orientation[0], 1.0, 1e-9);  // level, yaw 0
+  EXPECT_GT(s.attitude_covariance[0], 0.0);
+  EXPECT_EQ(s.attitude_covariance[0], s.covariance_diagonal[6]);
+
+  // VO: the first pose anchors the VO frame, the next ones are applied.
+  aerie::pose_t vo{};
+  vo.orientation[0] = 1.0;
+  for (int i = 0; i < 36; i += 7) vo.covariance[i] = 1e-4;
+  for (int k = 0; k < 5; ++k) {
+    vo.utime = t - 2500;  // between two IMU samples, behind the newest one
+    vo.seq = k;
+    vo.status = k == 0 ? aerie::pose_t::INITIALISING : aerie::pose_t::OK;
+    bus.publish("VO_POSE", vo);
+    for (int j = 0; j < 10; ++j) bus.publish("IMU", still_imu(t += 5000));
+    drain();
+  }
+  EXPECT_EQ(node.filter().counters().vo_anchors, 1);
+  EXPECT_EQ(states.back().vo_applied, 4);
+  EXPECT_EQ(states.back().status, aerie::nav_state_t::OK);
+  EXPECT_LT(std::abs(states.back().position[2]), 1e-3);
+
+  // Bad inputs: refused, counted, no NAV_STATE for a refused IMU sample.
+  const size_t before = states.size();
+  aerie::imu_t bad = still_imu(t + 5000);
+  bad.linear_acceleration[0] = std::nan("");
+  bus.publish("IMU", bad);
+  bus.publish("IMU", still_imu(t - 100000));  // back in time
+  vo.utime = t;
+  vo.orientation[0] = 2.0;  // not a unit quaternion
+  bus.publish("VO_POSE", vo);
+  vo.orientation[0] = 1.0;
+  vo.status = aerie::pose_t::LOST;
+  bus.publish("VO_POSE", vo);
+  drain();
+  EXPECT_EQ(states.size(), before);
+  EXPECT_EQ(node.counter("imu_refused"), 2);
+  EXPECT_EQ(node.filter().counters().imu_non_finite, 1);
+  EXPECT_EQ(node.filter().counters().imu_time_not_increasing, 1);
+  EXPECT_EQ(node.counter("vo_refused"), 1);
+  EXPECT_EQ(node.counter("vo_not_tracking"), 1);
+
+  // No VO for 0.4 s: IMU_ONLY, reported as a warning in the status.
+  for (int k = 0; k < 80; ++k) bus.publish("IMU", still_imu(t += 5000));
+  drain();
+  EXPECT_EQ(states.back().status, aerie::nav_state_t::IMU_ONLY);
+  EXPECT_GT(states.back().time_since_vo_s, 0.25);
+  bus::StatusReporter status(bus, "nav");
+  node.report(status);
+  EXPECT_EQ(status.counter("imu_refused"), 2);
+  EXPECT_EQ(status.counter("vo_applied"), 4);
+  EXPECT_EQ(status.counter("imu_non_finite"), 1);
+  for (size_t i = 1; i < states.size(); ++i) ASSERT_EQ(states[i].seq, states[i - 1].seq + 1);
+}
+
+TEST(NavNode, PublishRateLimitsNavState) {
+  bus::Bus bus("memq://");
+  nav::NavConfig cfg;
+  cfg.publish_rate_hz = 50.0;  // every 4th sample at 200 Hz
+  cfg.eskf.static_window_s = 0.1;
+  nav::NavNode node(bus, cfg);
+  int n = 0;
+  bus.subscribe<aerie::nav_state_t>("NAV_STATE", [&](const aerie::nav_state_t&, const bus::ReceiveInfo&) { ++n; });
+  int64_t t = 0;
+  for (int k = 0; k < 400; ++k) bus.publish("IMU", still_imu(t += 5000));
+  while (bus.handle(0) > 0) {
+  }
+  EXPECT_NEAR(n, 400 / 4 + 20, 21);  // about 100 after the alignment (+ the INITIALISING ones)
+  EXPECT_LT(n, 150);
+}
+
+TEST(NavConfig, FileDocumentsTheDefaultsAndIsStrict) {
+  const nav::NavConfig file = nav::load_nav_config(util::Config::load(AERIE_SOURCE_DIR "/config/nav.yaml"));
+  const nav::NavConfig defaults = nav::load_nav_config(util::Config());
+  const nav::EskfParams& a = file.eskf;
+  const nav::EskfParams& b = defaults.eskf;
+  EXPECT_EQ(file.publish_rate_hz, defaults.publish_rate_hz);
+  EXPECT_EQ(a.gyro_noise_density, b.gyro_noise_density);
+  EXPECT_EQ(a.accel_random_walk, b.accel_random_walk);
+  EXPECT_EQ(a.max_imu_dt_s, b.max_imu_dt_s);
+  EXPECT_EQ(a.static_window_s, b.static_window_s);
+  EXPECT_EQ(a.static_max_accel_std_m_s2, b.static_max_accel_std_m_s2);
+  EXPECT_NEAR(a.init_yaw_sigma_rad, b.init_yaw_sigma_rad, 1e-4);
+  EXPECT_NEAR(a.vo_rotation_sigma_rad, b.vo_rotation_sigma_rad, 1e-4);
+  EXPECT_EQ(a.gate_chi2, b.gate_chi2);
+  EXPECT_EQ(a.lost_after_s, b.lost_after_s);
+  EXPECT_EQ(a.buffer_s, b.buffer_s);
+  EXPECT_LT((a.T_body_cam.matrix() - b.T_body_cam.matrix()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((b.T_body_cam.matrix() - nav::sim_forward_rig_T_body_cam().matrix()).cwiseAbs().maxCoeff(), 1e-12);
+
+  auto refused = [](const std::string& yaml, const std::string& needle) {
+    try {
+      nav::load_nav_config(util::Config::parse(yaml, "nav-test.yaml"));
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+      return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused("imu: {max_dt: 0.1}\n", "unknown key 'max_dt'"));
+  EXPECT_TRUE(refused("gate: 3\n", "unknown key 'gate'"));
+  EXPECT_TRUE(refused("vo: {frame: world}\n", "vo.frame"));
+  EXPECT_TRUE(refused("outage: {imu_only_after_s: 3, lost_after_s: 2}\n", "lost_after_s"));
+  EXPECT_TRUE(refused("imu: {gyro_noise_density: -1}\n", "imu.gyro_noise_density"));
+  EXPECT_TRUE(refused("camera: {T_body_cam: [1, 0, 0]}\n", "16 numbers"));
+  EXPECT_TRUE(refused("camera: {T_body_cam: [2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}\n", "not a rotation"));
+  EXPECT_FALSE(refused("vo: {frame: fixed, noise: config}\npublish_rate_hz: 50\n", ""));
+}
