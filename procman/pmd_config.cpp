@@ -131,7 +131,7 @@ class Parser {
       if (kw.text == "cmd") {
         cfg.commands.push_back(command("", kw));
       } else if (kw.text == "group") {
-        group("", cfg, kw);
+        group("", cfg, kw, 1);
       } else if (kw.text == "script") {
         cfg.scripts.push_back(script(kw));
       } else {
@@ -216,7 +216,9 @@ class Parser {
     return c;
   }
 
-  void group(const std::string& parent, PmdConfig& cfg, const Token&) {
+  void group(const std::string& parent, PmdConfig& cfg, const Token& kw, int depth) {
+    if (depth > kMaxGroupDepth)
+      fail(kw, "groups nested more than " + std::to_string(kMaxGroupDepth) + " deep (in \"" + parent + "\")");
     const std::string name = name_string("group name");
     const std::string path = parent.empty() ? name : parent + "/" + name;
     expect(Tok::Open, "'{' after group name");
@@ -225,7 +227,7 @@ class Parser {
       if (kw.text == "cmd") {
         cfg.commands.push_back(command(path, kw));
       } else if (kw.text == "group") {
-        group(path, cfg, kw);
+        group(path, cfg, kw, depth + 1);
       } else {
         fail(kw, "expected 'cmd' or 'group' inside group \"" + path + "\", found " + describe(kw));
       }
@@ -335,21 +337,31 @@ void validate(const PmdConfig& cfg) {
       }
     }
   }
-  // run_script cycles would never end.
+  // run_script cycles would never end; chains are bounded (the recursion below, and the
+  // sheriff's script stack, are at most kMaxRunScriptDepth deep). height: the longest chain
+  // from a script, once known.
   std::map<std::string, int> mark;  // 0 new, 1 on stack, 2 done
-  std::function<void(const PmdScript&)> visit = [&](const PmdScript& s) {
+  std::map<std::string, int> height;
+  std::function<void(const PmdScript&, int)> visit = [&](const PmdScript& s, int depth) {
     mark[s.name] = 1;
+    int h = 1;
     for (const auto& a : s.actions) {
       if (a.kind != ActionKind::RunScript) continue;
       const PmdScript& t = *scripts.at(a.ident);
       if (mark[t.name] == 1)
         throw PmdError(cfg.origin, a.line, a.column, "run_script \"" + a.ident + "\" makes a cycle of scripts");
-      if (mark[t.name] == 0) visit(t);
+      if (depth >= kMaxRunScriptDepth || (mark[t.name] == 2 && depth + height[t.name] > kMaxRunScriptDepth))
+        throw PmdError(cfg.origin, a.line, a.column,
+                       "run_script \"" + a.ident + "\" chains scripts more than " + std::to_string(kMaxRunScriptDepth) +
+                           " deep");
+      if (mark[t.name] == 0) visit(t, depth + 1);
+      h = std::max(h, 1 + height[t.name]);
     }
+    height[s.name] = h;
     mark[s.name] = 2;
   };
   for (const auto& s : cfg.scripts)
-    if (mark[s.name] == 0) visit(s);
+    if (mark[s.name] == 0) visit(s, 1);
 }
 
 std::string quote(const std::string& s) {

@@ -70,8 +70,14 @@ class PmdError : public std::runtime_error {
   int line_, column_;
 };
 
+// Nesting bounds of a .pmd file, refused with the line of the offending group or
+// run_script (20,000 nested groups or 50,000 chained scripts overflowed the stack).
+inline constexpr int kMaxGroupDepth = 32;        // groups inside groups
+inline constexpr int kMaxRunScriptDepth = 32;    // scripts calling scripts (run_script chains)
+
 // Parses and validates (unique command names, a host and exec for every command,
-// scripts referring only to existing commands, groups and scripts, no run_script cycle).
+// scripts referring only to existing commands, groups and scripts, no run_script cycle,
+// the nesting bounds above).
 PmdConfig parse_pmd(const std::string& text, const std::string& origin = "<string>");
 PmdConfig load_pmd(const std::string& path);  // throws std::runtime_error if unreadable
 

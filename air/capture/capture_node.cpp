@@ -13,6 +13,14 @@
 namespace aerie::capture {
 
 CaptureConfig load_capture_config(const util::Config& c) {
+  c.check_keys({"source.type", "source.path", "source.right", "source.calib", "source.timestamps",
+                "source.groundtruth", "source.fps", "sim.seed", "sim.trajectory", "sim.speed", "sim.loops",
+                "sim.noise_sigma", "sim.start_utime", "output.width", "output.height", "output.downscale",
+                "output.color", "output.encoding", "output.jpeg_quality", "playback.rate", "playback.start",
+                "playback.stop", "playback.duration", "playback.loop", "playback.stamp",
+                "playback.max_consecutive_errors", "channels.left", "channels.right", "channels.stereo",
+                "channels.mono", "channels.gt_pose", "channels.gt_track"});
+  constexpr int64_t kMaxFrames = int64_t{1} << 40;
   CaptureConfig k;
   auto& s = k.source;
   s.type = c.get("source.type", s.type);
@@ -21,27 +29,27 @@ CaptureConfig load_capture_config(const util::Config& c) {
   s.calib = c.get("source.calib", s.calib);
   s.timestamps = c.get("source.timestamps", s.timestamps);
   s.groundtruth = c.get("source.groundtruth", s.groundtruth);
-  s.fps = c.get("source.fps", s.fps);
+  s.fps = c.get_in("source.fps", s.fps, 0.01, 1000.0);
   s.sim.seed = c.get<uint64_t>("sim.seed", s.sim.seed);
   s.sim.trajectory = c.get("sim.trajectory", s.sim.trajectory);
-  s.sim.speed = c.get("sim.speed", s.sim.speed);
-  s.sim.loops = c.get("sim.loops", s.sim.loops);
-  s.sim.noise_sigma = c.get("sim.noise_sigma", s.sim.noise_sigma);
-  s.sim.start_utime = c.get<int64_t>("sim.start_utime", s.sim.start_utime);
+  s.sim.speed = c.get_in("sim.speed", s.sim.speed, 0.01, 20.0);
+  s.sim.loops = c.get_in("sim.loops", s.sim.loops, 1, 1000);
+  s.sim.noise_sigma = c.get_in("sim.noise_sigma", s.sim.noise_sigma, 0.0, 255.0);
+  s.sim.start_utime = c.get_in<int64_t>("sim.start_utime", s.sim.start_utime, -1, int64_t{1} << 62);
   auto& o = k.output;
-  o.width = c.get("output.width", o.width);
-  o.height = c.get("output.height", o.height);
-  o.downscale = c.get("output.downscale", o.downscale);
+  o.width = c.get_in("output.width", o.width, 0, 16384);
+  o.height = c.get_in("output.height", o.height, 0, 16384);
+  o.downscale = c.get_in("output.downscale", o.downscale, 1.0, 64.0);
   o.color = c.get("output.color", o.color);
   k.encoding = c.get("output.encoding", k.encoding);
-  k.jpeg_quality = c.get("output.jpeg_quality", k.jpeg_quality);
-  k.rate = c.get("playback.rate", k.rate);
-  k.start = c.get<int64_t>("playback.start", k.start);
-  k.stop = c.get<int64_t>("playback.stop", k.stop);
-  k.duration_s = c.get("playback.duration", k.duration_s);
+  k.jpeg_quality = c.get_in("output.jpeg_quality", k.jpeg_quality, 1, 100);
+  k.rate = c.get_in("playback.rate", k.rate, 0.0, 1000.0);
+  k.start = c.get_in<int64_t>("playback.start", k.start, 0, kMaxFrames);
+  k.stop = c.get_in<int64_t>("playback.stop", k.stop, -1, kMaxFrames);
+  k.duration_s = c.get_in("playback.duration", k.duration_s, 0.0, 1e7);
   k.loop = c.get("playback.loop", k.loop);
   k.stamp = c.get("playback.stamp", k.stamp);
-  k.max_consecutive_errors = c.get("playback.max_consecutive_errors", k.max_consecutive_errors);
+  k.max_consecutive_errors = c.get_in("playback.max_consecutive_errors", k.max_consecutive_errors, 1, 1000000);
   auto& ch = k.channels;
   ch.left = c.get("channels.left", ch.left);
   ch.right = c.get("channels.right", ch.right);

@@ -18,7 +18,7 @@ Eigen::Vector3d vec3(const util::Config& cfg, const std::string& key, const Eige
 
 NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   sim::require_known_keys(cfg, {"controller", "input", "channels", "rate_hz", "reference_deg", "reference_relative",
-                                "forward_speed_m_s", "stale_timeout_s", "limits", "heading_frame"});
+                                "forward_speed_m_s", "stale_timeout_s", "limits", "heading_frame", "message_time"});
   NodeSetup s;
   const std::string file = !cli.controller.empty() ? cli.controller : cfg.get<std::string>("controller", "");
   s.controller = file.empty() ? flc::thesis_initial() : flc::load_controller(file);
@@ -44,6 +44,13 @@ NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   sim::require_known_keys(lim, {"max_yaw_rate_deg_s", "max_yaw_accel_deg_s2"});
   c.limits.max_yaw_rate_deg_s = lim.get("max_yaw_rate_deg_s", c.limits.max_yaw_rate_deg_s);
   c.limits.max_yaw_accel_deg_s2 = lim.get("max_yaw_accel_deg_s2", c.limits.max_yaw_accel_deg_s2);
+
+  // The message-time policy of the pose source; its stale timeout is stale_timeout_s above.
+  const auto mt = cfg.section("message_time");
+  if (mt.has("stale_timeout_s"))
+    throw std::runtime_error(cfg.origin() + ": 'message_time.stale_timeout_s' is not a key of aerie-control: "
+                             "staleness is the top-level 'stale_timeout_s'");
+  o.message_time = util::MessageClockConfig::from_config(mt, o.message_time);
 
   const auto fr = cfg.section("heading_frame");
   sim::require_known_keys(fr, {"up", "forward"});

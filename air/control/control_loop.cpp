@@ -1,6 +1,7 @@
 #include "air/control/control_loop.hpp"
 
 #include <cmath>
+#include <string>
 #include <stdexcept>
 
 #include "common/flc/pid_inputs.hpp"
@@ -10,9 +11,14 @@ namespace aerie::control {
 void ControlConfig::validate() const {
   if (!std::isfinite(reference_deg)) throw std::invalid_argument("control: reference_deg must be finite");
   if (!(forward_speed_m_s >= 0.0 && forward_speed_m_s < 20.0)) throw std::invalid_argument("control: forward_speed_m_s must be in [0, 20)");
-  if (!(stale_timeout_s > 0.0)) throw std::invalid_argument("control: stale_timeout_s must be > 0");
-  if (!(limits.max_yaw_rate_deg_s > 0.0) || !(limits.max_yaw_accel_deg_s2 >= 0.0))
-    throw std::invalid_argument("control: max_yaw_rate_deg_s must be > 0 and max_yaw_accel_deg_s2 >= 0");
+  if (!(stale_timeout_s > 0.0 && stale_timeout_s <= 60.0))
+    throw std::invalid_argument("control: stale_timeout_s must be in (0, 60] s, got " + std::to_string(stale_timeout_s));
+  if (!(limits.max_yaw_rate_deg_s > 0.0 && limits.max_yaw_rate_deg_s <= 720.0))
+    throw std::invalid_argument("control: limits.max_yaw_rate_deg_s must be in (0, 720] deg/s, got " +
+                                std::to_string(limits.max_yaw_rate_deg_s));
+  if (!(limits.max_yaw_accel_deg_s2 >= 0.0 && limits.max_yaw_accel_deg_s2 <= 10000.0))
+    throw std::invalid_argument("control: limits.max_yaw_accel_deg_s2 must be in [0, 10000] deg/s^2, got " +
+                                std::to_string(limits.max_yaw_accel_deg_s2));
 }
 
 ControlLoop::ControlLoop(flc::FlcSpec controller, ControlConfig config)
@@ -24,7 +30,7 @@ bool ControlLoop::stale(int64_t now_us) const {
 
 bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us) {
   if (!std::isfinite(heading_deg)) return false;
-  if (have_input_ && utime <= last_utime_) return false;
+  if (have_time_ && utime <= last_utime_) return false;
   // Input resumed after going stale: the derivative and integral start afresh.
   if (have_input_ && stale(receive_wall_us)) loop_.reset();
   if (!have_reference_) {
@@ -32,7 +38,7 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
     have_reference_ = true;
   }
   const double u = loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_);
-  have_input_ = true;
+  have_input_ = have_time_ = true;
   last_utime_ = utime;
   last_receive_ = receive_wall_us;
   active_.mode = Mode::kActive;
@@ -43,6 +49,11 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
   active_.error_deg = loop_.inputs()[0];
   active_.source_utime = utime;
   return true;
+}
+
+void ControlLoop::resync() {
+  have_time_ = false;
+  loop_.reset();
 }
 
 std::optional<std::string> ControlLoop::set_controller(const flc::FlcSpec& spec) {

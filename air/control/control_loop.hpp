@@ -41,6 +41,10 @@ class ControlLoop {
   // Returns false (and ignores it) if it is not newer than the last one or not finite.
   bool on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us);
 
+  // The heading source re-synchronised to a new time base (restart, outage; util::MessageClock):
+  // the next heading is taken whatever its utime, and the derivative and integral start afresh.
+  void resync();
+
   // Replaces the controller if it is valid; otherwise keeps the current one and
   // returns the reason it was refused.
   std::optional<std::string> set_controller(const flc::FlcSpec& spec);
@@ -55,7 +59,7 @@ class ControlLoop {
  private:
   ControlConfig cfg_;
   flc::HeadingLoop loop_;
-  bool have_input_ = false, have_reference_ = false;
+  bool have_input_ = false, have_reference_ = false, have_time_ = false;
   double reference_ = 0.0;
   int64_t last_utime_ = 0, last_receive_ = 0;
   Command active_;

@@ -37,24 +37,41 @@ flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::Fl
   return spec;
 }
 
-ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options)
-    : bus_(bus), status_(status), opt_(std::move(options)), loop_(std::move(controller), opt_.control) {
-  if (!(opt_.rate_hz > 0.0 && opt_.rate_hz <= 1000.0)) throw std::invalid_argument("control: rate_hz must be in (0, 1000]");
-  opt_.frame.validate();
+namespace {
+
+NodeOptions checked(NodeOptions o) {
+  if (!(o.rate_hz > 0.0 && o.rate_hz <= 1000.0)) throw std::invalid_argument("control: rate_hz must be in (0, 1000]");
+  o.frame.validate();
+  o.control.validate();
+  if (o.pose_channel.empty())
+    o.pose_channel = o.input == NodeOptions::Input::kVoPose ? channels::kVoPose : channels::kGtPose;
+  o.message_time.stale_timeout_us = static_cast<int64_t>(std::llround(o.control.stale_timeout_s * 1e6));
+  return o;
+}
+
+}  // namespace
+
+ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options,
+                         util::NodeClock now)
+    : bus_(bus),
+      status_(status),
+      opt_(checked(std::move(options))),
+      loop_(std::move(controller), opt_.control),
+      now_(std::move(now)),
+      pose_clock_(status, opt_.pose_channel, opt_.message_time) {
   period_us_ = static_cast<int64_t>(1e6 / opt_.rate_hz);
   const bool vo = opt_.input == NodeOptions::Input::kVoPose;
-  if (opt_.pose_channel.empty()) opt_.pose_channel = vo ? channels::kVoPose : channels::kGtPose;
   if (vo) {
-    bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo& info) {
+    bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
       if (m.status != aerie::pose_t::OK) {
         status_.count("pose_not_ok");  // initialising/lost: no heading, the fallback takes over when stale
         return;
       }
-      on_pose(m.utime, m.orientation, info.recv_utime);
+      on_pose(m.utime, m.orientation);
     });
   } else {
-    bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo& info) {
-      on_pose(m.utime, m.orientation, info.recv_utime);
+    bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
+      on_pose(m.utime, m.orientation);
     });
   }
   bus_.subscribe<aerie::flc_params_t>(opt_.params_channel,
@@ -62,7 +79,7 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
   status_.ok("controller " + loop_.controller().id);
 }
 
-void ControlNode::on_pose(int64_t utime, const double orientation[4], int64_t receive_us) {
+void ControlNode::on_pose(int64_t utime, const double orientation[4]) {
   double heading = 0.0;
   try {
     heading = heading_from_quaternion(orientation, opt_.frame);
@@ -74,20 +91,22 @@ void ControlNode::on_pose(int64_t utime, const double orientation[4], int64_t re
       spdlog::warn("pose on {}: {} ({} so far; check heading_frame)", opt_.pose_channel, e.what(), bad_poses_);
     return;
   }
-  on_heading(utime, heading, receive_us);
+  on_heading(utime, heading, now_());
 }
 
 void ControlNode::on_heading(int64_t utime, double heading_deg, int64_t receive_us) {
+  // A pose whose time jumps (utime = INT64_MAX, a restarted VO) is held and counted
+  // ("<channel>.time_jumps") without touching the loop; after resync_messages consistent
+  // ones the loop follows the new time base.
+  const auto time = pose_clock_.observe(utime, receive_us);
+  if (!time.accepted()) return;
+  if (time.verdict == util::MessageClock::Verdict::kResynced) loop_.resync();
   if (!loop_.on_heading(utime, heading_deg, receive_us)) {
     status_.count("pose_out_of_order");
     return;
   }
   status_.count("poses");
   last_receive_ = receive_us;
-  if (stale_reported_) {
-    status_.ok("input resumed; controller " + loop_.controller().id);
-    stale_reported_ = false;
-  }
 }
 
 void ControlNode::on_params(const aerie::flc_params_t& m) {
@@ -132,11 +151,8 @@ void ControlNode::publish_command(int64_t now_us) {
   m.heading_error_deg = static_cast<float>(c.error_deg);
   bus_.publish(opt_.command_channel, m);
   status_.count(c.mode == Mode::kActive ? "commands_active" : c.mode == Mode::kHover ? "commands_hover" : "commands_fallback");
-  if (c.mode == Mode::kFallbackHover && !stale_reported_) {
-    status_.warn("no heading for more than " + std::to_string(opt_.control.stale_timeout_s) + " s: hovering");
-    spdlog::warn("input stale: fallback hover");
-    stale_reported_ = true;
-  }
+  // Stale (FALLBACK_HOVER) after stale_timeout_s, and live again, in the status: "<channel>.stale".
+  pose_clock_.check(now_us);
   status_.mark_hop(c.source_utime, last_receive_, util::wall_utime());
 }
 

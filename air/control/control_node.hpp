@@ -12,7 +12,9 @@
 #include "air/control/control_loop.hpp"
 #include "air/control/heading_from_pose.hpp"
 #include "common/bus/bus.hpp"
+#include "common/bus/input_clock.hpp"
 #include "common/bus/status.hpp"
+#include "common/util/time.hpp"
 
 namespace aerie::control {
 
@@ -25,6 +27,8 @@ struct NodeOptions {
   double rate_hz = 30.0;              // CTRL_CMD rate
   HeadingFrame frame;
   ControlConfig control;
+  // message_time.max_jump_s / resync_messages; its stale timeout is control.stale_timeout_s.
+  util::MessageClockConfig message_time;
 };
 
 // The controller a FLC_PARAMS message describes: its FLL if it has one, else the
@@ -33,7 +37,10 @@ flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::Fl
 
 class ControlNode {
  public:
-  ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options);
+  // `now` is the node's clock: the receive time of a pose for staleness (wall clock live;
+  // tests and lock-step drivers pass theirs, the same one they give tick()).
+  ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options,
+              util::NodeClock now = util::wall_utime);
 
   // Publishes a command when a period of the rate has elapsed since the last one.
   void tick(int64_t now_us);
@@ -41,7 +48,7 @@ class ControlNode {
   const ControlLoop& loop() const { return loop_; }
 
  private:
-  void on_pose(int64_t utime, const double orientation[4], int64_t receive_us);
+  void on_pose(int64_t utime, const double orientation[4]);
   void on_heading(int64_t utime, double heading_deg, int64_t receive_us);
   void on_params(const aerie::flc_params_t& m);
 
@@ -50,7 +57,8 @@ class ControlNode {
   NodeOptions opt_;
   ControlLoop loop_;
   int64_t seq_ = 0, next_publish_ = 0, period_us_ = 0, last_receive_ = 0;
-  bool stale_reported_ = false;
+  util::NodeClock now_;
+  bus::InputClock pose_clock_;  // the message-time policy of the pose source
   int64_t bad_poses_ = 0;
 };
 

@@ -28,6 +28,17 @@ class Params {
     known_.insert(key);
     value = cfg_.get<T>(key, value);
   }
+  // A size or count that sets how much is allocated or looped over per frame: bounded
+  // before any allocation (a TRACK_CMD override of features=1e7 stalled tracking).
+  template <typename T>
+  void read_in(const std::string& key, T& value, T lo, T hi) {
+    known_.insert(key);
+    try {
+      value = cfg_.get_in<T>(key, value, lo, hi);
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument(e.what());
+    }
+  }
   void read_list(const std::string& key, std::vector<double>& value) {
     known_.insert(key);
     if (!cfg_.has(key)) return;
@@ -53,18 +64,18 @@ class Params {
 
 DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
   in.read("channels", p.channels);
-  in.read("max_levels", p.max_levels);
+  in.read_in("max_levels", p.max_levels, 1, 8);
   in.read("min_size", p.min_size);
-  in.read("search_radius", p.search_radius);
-  in.read("coarse_radius", p.coarse_radius);
+  in.read_in("search_radius", p.search_radius, 0.0, 200.0);
+  in.read_in("coarse_radius", p.coarse_radius, 0.0, 100.0);
   in.read("pos_radius", p.pos_radius);
   in.read("neg_inner", p.neg_inner);
-  in.read("neg_outer", p.neg_outer);
-  in.read("neg_count", p.neg_count);
+  in.read_in("neg_outer", p.neg_outer, 0.0, 400.0);
+  in.read_in("neg_count", p.neg_count, 0, 10000);
   in.read("min_pos_radius", p.min_pos_radius);
   in.read_list("reject_ratio", p.reject_ratio);
   in.read("min_radius", p.min_radius);
-  in.read("max_radius", p.max_radius);
+  in.read_in("max_radius", p.max_radius, 0.0, 200.0);
   in.read("scale_estimation", p.scale_estimation);
   in.read("scale_step", p.scale_step);
   in.read("max_scale_change", p.max_scale_change);
@@ -73,9 +84,9 @@ DiscriminativeParams read_discriminative(Params& in, DiscriminativeParams p) {
   in.read("flow_prediction", p.flow_prediction);
   in.read("redetection", p.redetection);
   in.read("confidence_rate", p.confidence_rate);
-  in.read("lost_frames", p.lost_frames);
+  in.read_in("lost_frames", p.lost_frames, 1, 100000);
   in.read("found_confidence", p.found_confidence);
-  in.read("redetect_stride", p.redetect_stride);
+  in.read_in("redetect_stride", p.redetect_stride, 1, 1000);
   in.read("redetect_radius", p.redetect_radius);
   in.read("update_confidence", p.update_confidence);
   return p;
@@ -115,9 +126,9 @@ std::unique_ptr<Tracker> make_ct(const std::string& name, const util::Config& cf
   CtParams ct;
   ct.features = features;
   ct.learning_rate = learning_rate;
-  in.read("features", ct.features);
-  in.read("min_rects", ct.min_rects);
-  in.read("max_rects", ct.max_rects);
+  in.read_in("features", ct.features, 1, 10000);
+  in.read_in("min_rects", ct.min_rects, 1, 16);
+  in.read_in("max_rects", ct.max_rects, 1, 16);
   in.read("learning_rate", ct.learning_rate);
   in.read("sigma_min", ct.sigma_min);
   ct.log_floor = read_density_floor(in);
@@ -130,10 +141,10 @@ std::unique_ptr<Tracker> make_mil(const std::string& name, const util::Config& c
                                   DiscriminativeParams defaults) {
   Params in(cfg, name);
   MilParams mil;
-  in.read("features", mil.features);
-  in.read("selected", mil.selected);
-  in.read("min_rects", mil.min_rects);
-  in.read("max_rects", mil.max_rects);
+  in.read_in("features", mil.features, 1, 10000);
+  in.read_in("selected", mil.selected, 1, 10000);
+  in.read_in("min_rects", mil.min_rects, 1, 16);
+  in.read_in("max_rects", mil.max_rects, 1, 16);
   in.read("learning_rate", mil.learning_rate);
   in.read("sigma_min", mil.sigma_min);
   mil.log_floor = read_density_floor(in);
@@ -145,34 +156,34 @@ std::unique_ptr<Tracker> make_mil(const std::string& name, const util::Config& c
 std::unique_ptr<Tracker> make_dcf(const util::Config& cfg) {
   Params in(cfg, "dcf");
   DcfParams p;
-  in.read("cell", p.cell);
-  in.read("padding", p.padding);
-  in.read("template_area", p.template_area);
+  in.read_in("cell", p.cell, 1, 16);
+  in.read_in("padding", p.padding, 0.0, 10.0);
+  in.read_in("template_area", p.template_area, 64.0, 1048576.0);
   in.read("output_sigma", p.output_sigma);
   in.read("lambda", p.lambda);
   in.read("learning_rate", p.learning_rate);
   in.read("spatial_mask", p.spatial_mask);
   in.read("mask_scale", p.mask_scale);
-  in.read("admm_iterations", p.admm_iterations);
+  in.read_in("admm_iterations", p.admm_iterations, 0, 100);
   in.read("admm_mu", p.admm_mu);
   in.read("admm_beta", p.admm_beta);
   in.read("admm_mu_max", p.admm_mu_max);
   in.read("hist_weight", p.hist_weight);
-  in.read("hist_bins", p.hist_bins);
+  in.read_in("hist_bins", p.hist_bins, 2, 256);
   in.read("hist_learning_rate", p.hist_learning_rate);
   in.read("inner_padding", p.inner_padding);
-  in.read("scales", p.scales);
+  in.read_in("scales", p.scales, 1, 129);
   in.read("scale_step", p.scale_step);
   in.read("scale_sigma", p.scale_sigma);
   in.read("scale_lambda", p.scale_lambda);
   in.read("scale_learning_rate", p.scale_learning_rate);
-  in.read("scale_model_area", p.scale_model_area);
+  in.read_in("scale_model_area", p.scale_model_area, 16.0, 65536.0);
   in.read("min_scale", p.min_scale);
   in.read("max_scale", p.max_scale);
   in.read("update_confidence", p.update_confidence);
   in.read("confidence_rate", p.confidence_rate);
   in.read("redetection", p.redetection);
-  in.read("lost_frames", p.lost_frames);
+  in.read_in("lost_frames", p.lost_frames, 1, 100000);
   in.read("found_confidence", p.found_confidence);
   in.check_unknown();
   return std::make_unique<DcfTracker>(p);

@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);
   try {
     stereo::VoParams params =
-        config.empty() ? stereo::VoParams{} : stereo::vo_params_from_config(util::Config::load(config), {"node"});
+        config.empty() ? stereo::VoParams{} : stereo::vo_params_from_config(util::Config::load(config), stereo::kNodeSections);
     params.ba_synchronous = ba_sync;
     Source src = open_dataset(dataset, exact_depth);
     if (exact_depth && dataset.rfind("sim:", 0) != 0) throw std::runtime_error("--exact-depth needs a sim: dataset");

@@ -30,6 +30,7 @@ class StatusReporter {
   void publish_now();
   const std::string& channel() const { return channel_; }
   int64_t counter(const std::string& name) const;
+  const std::string& message() const { return message_; }  // the latest ok/warn/error message
 
  private:
   Bus& bus_;

@@ -1,7 +1,9 @@
 #include "common/flc/flc.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <set>
 #include <stdexcept>
 
@@ -20,6 +22,8 @@ void validate_variable(const Variable& v, const char* role, int min_sets) {
   const std::string where = std::string(role) + " '" + v.name + "'";
   if (v.name.empty()) fail(std::string(role) + " variable has no name");
   if (v.size() < min_sets) fail(where + " needs at least " + std::to_string(min_sets) + " sets, has " + std::to_string(v.size()));
+  if (v.sets.size() > static_cast<size_t>(kMaxSets))
+    fail(where + " has " + std::to_string(v.sets.size()) + " sets, more than " + std::to_string(kMaxSets));
   if (v.positions.size() != v.sets.size())
     fail(where + " has " + std::to_string(v.sets.size()) + " set names but " + std::to_string(v.positions.size()) + " positions");
   if (!std::isfinite(v.min) || !std::isfinite(v.max) || !(v.min < v.max))
@@ -79,7 +83,26 @@ double membership(const Variable& v, int k, double x) {
   return x < b ? (x - a) / (b - a) : (e - x) / (e - b);
 }
 
+int64_t rule_table_cells(const std::array<int, kInputs>& sets) {
+  int64_t cells = 1;
+  std::string product;
+  bool overflow = false;
+  for (int n : sets) {
+    if (n < 0) fail("a variable has a negative number of sets");
+    overflow |= __builtin_mul_overflow(cells, int64_t{n}, &cells);
+    product += (product.empty() ? "" : " x ") + std::to_string(n);
+  }
+  if (overflow || cells > kMaxRuleCells)
+    fail("the rule table of " + product + " input sets" + (overflow ? "" : " = " + std::to_string(cells) + " cells") +
+         " is larger than " + std::to_string(kMaxRuleCells) + " cells");
+  return cells;
+}
+
 void FlcSpec::validate() const {
+  // The table's size first: what a hostile controller would make us allocate.
+  rule_table_cells({static_cast<int>(std::min<size_t>(inputs[0].sets.size(), INT32_MAX)),
+                    static_cast<int>(std::min<size_t>(inputs[1].sets.size(), INT32_MAX)),
+                    static_cast<int>(std::min<size_t>(inputs[2].sets.size(), INT32_MAX))});
   std::set<std::string> names;
   for (const auto& v : inputs) {
     validate_variable(v, "input", 2);
@@ -169,8 +192,8 @@ void FlcSpec::set_parameter(std::string_view name, double value) {
 Flc::Flc(FlcSpec spec) : spec_(std::move(spec)) {
   spec_.validate();
   const auto& in = spec_.inputs;
-  stride_ = {in[1].size() * in[2].size(), in[2].size(), 1};
-  const size_t cells = static_cast<size_t>(in[0].size() * in[1].size() * in[2].size());
+  const auto cells = static_cast<size_t>(rule_table_cells({in[0].size(), in[1].size(), in[2].size()}));
+  stride_ = {in[1].size() * in[2].size(), in[2].size(), 1};  // < kMaxRuleCells: no overflow
   rule_out_.assign(cells, -1);
   rule_weight_.assign(cells, 0.0);
   for (const Rule& r : spec_.rules) {

@@ -20,6 +20,13 @@
 namespace aerie::flc {
 
 inline constexpr int kInputs = 3;  // error, derivative, integral
+// Bounds of a controller from outside (FLC_PARAMS, FLL and YAML files), checked by
+// FlcSpec::validate() before anything is allocated: the thesis uses 5 x 5 x 5 rules.
+inline constexpr int kMaxSets = 64;                        // sets of one variable
+inline constexpr int64_t kMaxRuleCells = int64_t{1} << 18;  // input sets multiplied (the rule table)
+// Cells of the dense rule table (input set counts multiplied, checked 64-bit arithmetic);
+// throws std::invalid_argument naming the product when it exceeds kMaxRuleCells.
+int64_t rule_table_cells(const std::array<int, kInputs>& sets);
 
 // One linguistic variable: ordered sets with strictly increasing positions.
 struct Variable {

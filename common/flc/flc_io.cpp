@@ -320,6 +320,8 @@ FlcSpec parse_fll(const std::string& text, const std::string& origin) {
     return v;
   };
   std::string id, engine;
+  if (text.size() > kMaxFllBytes)
+    fail(0, "FLL text of " + std::to_string(text.size()) + " bytes, more than " + std::to_string(kMaxFllBytes));
   std::map<std::string, double> scaling;
   std::vector<FllVariable> inputs, outputs;
   std::map<std::string, std::string> block;
@@ -372,6 +374,8 @@ FlcSpec parse_fll(const std::string& text, const std::string& origin) {
       } else if (key == "term") {
         auto w = words(value);
         if (w.size() < 2) fail(ln, "term of '" + v.name + "' must be '<name> <shape> <parameters>'");
+        if (v.terms.size() >= static_cast<size_t>(kMaxSets))
+          fail(ln, "'" + v.name + "' has more than " + std::to_string(kMaxSets) + " terms");
         FllTerm t{w[0], w[1], {}, ln};
         for (size_t k = 2; k < w.size(); ++k) t.params.push_back(number(ln, w[k]));
         v.terms.push_back(t);

@@ -24,6 +24,8 @@ void save_yaml(const FlcSpec& spec, const std::string& path);
 // FLL (fuzzylite 6). Import accepts the subset that eq. 5.1 covers and refuses the
 // rest with a reason (other term shapes, norms, defuzzifiers, hedges, "or").
 std::string to_fll(const FlcSpec& spec);
+// FLL text longer than this is refused before it is parsed (FLC_PARAMS, --controller files).
+inline constexpr size_t kMaxFllBytes = size_t{1} << 20;
 FlcSpec parse_fll(const std::string& text, const std::string& origin = "<string>");
 FlcSpec load_fll(const std::string& path);
 void save_fll(const FlcSpec& spec, const std::string& path);

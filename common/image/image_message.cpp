@@ -1,6 +1,8 @@
 #include "common/image/image_message.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <cstdint>
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -57,13 +59,48 @@ aerie::image_t to_message(const cv::Mat& img, int64_t utime, int64_t seq, Encodi
   return msg;
 }
 
-cv::Mat from_message(const aerie::image_t& msg) {
+std::optional<cv::Size> encoded_size(const uint8_t* d, size_t n, bool png) {
+  const auto be16 = [&](size_t i) { return (int{d[i]} << 8) | d[i + 1]; };
+  const auto be32 = [&](size_t i) {
+    return (uint32_t{d[i]} << 24) | (uint32_t{d[i + 1]} << 16) | (uint32_t{d[i + 2]} << 8) | d[i + 3];
+  };
+  if (png) {  // signature, then the IHDR chunk: length, "IHDR", width, height (big-endian)
+    static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (n < 24 || !std::equal(sig, sig + 8, d) || !std::equal(d + 12, d + 16, "IHDR")) return std::nullopt;
+    const uint32_t w = be32(16), h = be32(20);
+    if (w > INT32_MAX || h > INT32_MAX) return std::nullopt;
+    return cv::Size(static_cast<int>(w), static_cast<int>(h));
+  }
+  if (n < 4 || d[0] != 0xFF || d[1] != 0xD8) return std::nullopt;  // SOI, then segments up to the frame header
+  size_t i = 2;
+  while (i + 4 <= n) {
+    if (d[i] != 0xFF) return std::nullopt;
+    const uint8_t marker = d[i + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++i;
+      continue;
+    }
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (sof) {
+      if (i + 9 > n) return std::nullopt;
+      return cv::Size(be16(i + 7), be16(i + 5));
+    }
+    if (marker == 0xDA || marker == 0xD9) return std::nullopt;  // scan or end before any frame header
+    i += 2 + static_cast<size_t>(be16(i + 2));
+  }
+  return std::nullopt;
+}
+
+cv::Mat from_message(const aerie::image_t& msg, int64_t max_pixels) {
   auto bad = [&](const std::string& what) {
     throw std::invalid_argument("image message (utime " + std::to_string(msg.utime) + ", " +
                                 pixel_format_name(msg.pixelformat) + "): " + what);
   };
   if (msg.width <= 0 || msg.height <= 0)
     bad("invalid size " + std::to_string(msg.width) + "x" + std::to_string(msg.height));
+  if (static_cast<int64_t>(msg.width) * msg.height > max_pixels)
+    bad("image of " + std::to_string(msg.width) + "x" + std::to_string(msg.height) + " is larger than the limit of " +
+        std::to_string(max_pixels) + " pixels");
   if (msg.size != static_cast<int32_t>(msg.data.size())) bad("size field disagrees with the payload length");
   switch (msg.pixelformat) {
     case aerie::image_t::PIXEL_FORMAT_GRAY:
@@ -86,6 +123,11 @@ cv::Mat from_message(const aerie::image_t& msg) {
     }
     case aerie::image_t::PIXEL_FORMAT_MJPEG:
     case aerie::image_t::PIXEL_FORMAT_PNG: {
+      const auto declared = encoded_size(msg.data.data(), msg.data.size(), msg.pixelformat == aerie::image_t::PIXEL_FORMAT_PNG);
+      if (!declared) bad("payload cannot be decoded: no readable " + pixel_format_name(msg.pixelformat) + " header");
+      if (declared->width != msg.width || declared->height != msg.height)
+        bad("payload declares " + std::to_string(declared->width) + "x" + std::to_string(declared->height) +
+            ", header says " + std::to_string(msg.width) + "x" + std::to_string(msg.height) + " (not decoded)");
       const cv::Mat buf(1, msg.size, CV_8UC1, const_cast<uint8_t*>(msg.data.data()));
       cv::Mat out = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
       if (out.empty()) bad("payload cannot be decoded");
@@ -101,8 +143,8 @@ cv::Mat from_message(const aerie::image_t& msg) {
   return {};
 }
 
-cv::Mat gray_from_message(const aerie::image_t& msg) {
-  cv::Mat img = from_message(msg);
+cv::Mat gray_from_message(const aerie::image_t& msg, int64_t max_pixels) {
+  cv::Mat img = from_message(msg, max_pixels);
   if (img.channels() == 3) cv::cvtColor(img, img, cv::COLOR_BGR2GRAY);
   return img;
 }

@@ -16,12 +16,22 @@ Encoding encoding_from_string(const std::string& name);  // "raw", "jpeg", "png"
 aerie::image_t to_message(const cv::Mat& img, int64_t utime, int64_t seq, Encoding encoding = Encoding::Raw,
                           int jpeg_quality = 90);
 
+// Largest image from_message decodes by default (pixels): 4096 x 4096.
+inline constexpr int64_t kMaxPixels = int64_t{4096} * 4096;
+
+// The width x height a PNG (IHDR) or JPEG (SOFn) payload declares in its header, read
+// without decoding; nullopt when the header cannot be read.
+std::optional<cv::Size> encoded_size(const uint8_t* data, size_t size, bool png);
+
 // Decodes any supported payload to CV_8UC1 or CV_8UC3 (BGR). Throws
 // std::invalid_argument naming what is inconsistent (size vs width*height, unknown
 // pixel format, undecodable JPEG/PNG, ...). The result never aliases msg.data.
-cv::Mat from_message(const aerie::image_t& msg);
+// Images of more than max_pixels are refused, and a PNG/JPEG whose header declares another
+// size than width x height is refused before it is decoded (a 249 KB PNG can declare
+// 16000 x 16000 and inflate to 256 MB).
+cv::Mat from_message(const aerie::image_t& msg, int64_t max_pixels = kMaxPixels);
 // As from_message, converted to 8-bit gray.
-cv::Mat gray_from_message(const aerie::image_t& msg);
+cv::Mat gray_from_message(const aerie::image_t& msg, int64_t max_pixels = kMaxPixels);
 
 std::string pixel_format_name(int32_t pixelformat);
 

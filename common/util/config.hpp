@@ -1,11 +1,18 @@
 #pragma once
 // YAML configuration (yaml-cpp) with errors that name the file and the key.
 // Keys are dotted paths: cfg.get<double>("ipsl.forgetting_factor", 0.95).
+// load() and parse() refuse a path that is not a regular file (a FIFO would block the
+// node) and a document with a key given twice in one map (yaml-cpp keeps the first
+// silently); check_keys() refuses what a node does not read; get_in() refuses a number
+// outside its documented range.
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace aerie::util {
 
@@ -28,7 +35,28 @@ class Config {
     if (!n) throw std::runtime_error(origin_ + ": missing required key '" + key + "'");
     return convert<T>(*n, key);
   }
+  // get() for a number that must lie in [lo, hi]: NaN or a value outside is refused, naming
+  // the key, the value, the range and the line (a value left out takes `fallback` unchecked).
+  template <typename T>
+  T get_in(const std::string& key, const T& fallback, const T& lo, const T& hi) const {
+    const auto n = find(key);
+    if (!n) return fallback;
+    const T v = convert<T>(*n, key);
+    if (!(v >= lo && v <= hi)) {
+      std::ostringstream s;
+      s << origin_ << ": key '" << key << "' = " << v << " is outside its valid range [" << lo << ", " << hi
+        << "] (line " << n->Mark().line + 1 << ")";
+      throw std::runtime_error(s.str());
+    }
+    return v;
+  }
   Config section(const std::string& key) const;  // empty Config when absent
+  // Refuses, naming the file, the key and its line: a document (or section) that is not a
+  // map of keys (a top-level list or scalar), a key that is not in `known`, and a scalar or
+  // list where a section belongs. `known` holds the dotted paths of the keys that take a
+  // value ("sensor_model.max_range"); their prefixes are the sections ("sensor_model");
+  // "name.*" accepts any content under `name` (checked by its own reader).
+  void check_keys(const std::vector<std::string>& known) const;
   const std::string& origin() const { return origin_; }
   const YAML::Node& node() const { return root_; }
 

@@ -2,6 +2,7 @@
 
 #include <dynamicEDT3D/dynamicEDTOctomap.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -41,6 +42,12 @@ void DistanceMap::update(OccupancyMap& map) {
     const Eigen::Vector3d min = lo.array() - pad, max = hi.array() + pad;
     const Eigen::Vector3d cells = ((max - min) / map.params().resolution).array().ceil();
     const double n = cells.prod();
+    // DynamicEDT3D indexes a dense grid of float coordinates: it needs at least one cell per
+    // axis and bounds that floats hold (a map of resolution 1e300 crashed it).
+    const double extent = std::max(min.cwiseAbs().maxCoeff(), max.cwiseAbs().maxCoeff());
+    if (!cells.allFinite() || !(cells.minCoeff() >= 1) || !(extent < 1e7))
+      throw std::runtime_error("distance_map: the map's bounds cannot be gridded at resolution " +
+                               std::to_string(map.params().resolution) + " m");
     if (n > static_cast<double>(max_cells_))
       throw std::runtime_error("distance_map: the map needs " + std::to_string(static_cast<long long>(n)) +
                                " cells, more than distance_map.max_cells (" + std::to_string(max_cells_) + ")");

@@ -42,7 +42,10 @@ int main(int argc, char** argv) {
     if (!load_path.empty()) service.load(load_path);
     spdlog::info("mapping {} + {} at {} m (max range {} m) on {}", cfg.pose_channel, cfg.depth_channel,
                  service.map().params().resolution, cfg.occupancy.sensor_model.max_range, bus.url());
-    aerie::bus::run(bus, status);
+    aerie::bus::run(bus, status, [&] {
+      service.tick();  // reports VO_POSE/VO_DEPTH stale during an outage
+      return true;
+    });
 
     if (!save_path.empty()) {
       service.save(save_path);

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -39,55 +41,65 @@ void merge(std::optional<Region>& into, const std::optional<Region>& r) {
 }  // namespace
 
 MapServiceConfig MapServiceConfig::from_config(const util::Config& cfg) {
+  cfg.check_keys({"resolution", "sensor_model.max_range", "sensor_model.hit", "sensor_model.miss", "sensor_model.min",
+                  "sensor_model.max", "pointcloud_min_z", "pointcloud_max_z", "stereo.focal_px", "stereo.baseline_m",
+                  "stereo.disparity_sigma_px", "stereo.free_margin_sigmas", "stereo.weight_hits",
+                  "visibility_if_occluded", "distance_map.max_distance", "distance_map.max_cells", "publish.period_s",
+                  "publish.full_every", "publish.binary", "matching.pose_tolerance_us", "matching.pose_wait_us",
+                  "matching.pose_buffer", "message_time.*", "channels.pose", "channels.depth",
+                  "channels.octomap", "channels.query", "channels.response", "channels.cmd", "files.directory"});
   MapServiceConfig c;
   auto& o = c.occupancy;
-  o.resolution = cfg.get("resolution", o.resolution);
-  o.sensor_model.max_range = cfg.get("sensor_model.max_range", o.sensor_model.max_range);
+  // Ranges as documented in config/map.yaml; the probabilities are checked by validate().
+  o.resolution = cfg.get_in("resolution", o.resolution, kMinResolution, kMaxResolution);
+  o.sensor_model.max_range = cfg.get_in("sensor_model.max_range", o.sensor_model.max_range, 0.01, kMaxRange);
   o.sensor_model.hit = cfg.get("sensor_model.hit", o.sensor_model.hit);
   o.sensor_model.miss = cfg.get("sensor_model.miss", o.sensor_model.miss);
   o.sensor_model.min = cfg.get("sensor_model.min", o.sensor_model.min);
   o.sensor_model.max = cfg.get("sensor_model.max", o.sensor_model.max);
-  o.pointcloud_min_z = cfg.get("pointcloud_min_z", o.pointcloud_min_z);
-  o.pointcloud_max_z = cfg.get("pointcloud_max_z", o.pointcloud_max_z);
-  o.stereo.focal_px = cfg.get("stereo.focal_px", o.stereo.focal_px);
-  o.stereo.baseline_m = cfg.get("stereo.baseline_m", o.stereo.baseline_m);
-  o.stereo.disparity_sigma_px = cfg.get("stereo.disparity_sigma_px", o.stereo.disparity_sigma_px);
-  o.stereo.free_margin_sigmas = cfg.get("stereo.free_margin_sigmas", o.stereo.free_margin_sigmas);
+  o.pointcloud_min_z = cfg.get_in("pointcloud_min_z", o.pointcloud_min_z, -1e6, 1e6);
+  o.pointcloud_max_z = cfg.get_in("pointcloud_max_z", o.pointcloud_max_z, -1e6, 1e6);
+  o.stereo.focal_px = cfg.get_in("stereo.focal_px", o.stereo.focal_px, 0.0, 1e5);
+  o.stereo.baseline_m = cfg.get_in("stereo.baseline_m", o.stereo.baseline_m, 0.0, 100.0);
+  o.stereo.disparity_sigma_px = cfg.get_in("stereo.disparity_sigma_px", o.stereo.disparity_sigma_px, 0.0, 100.0);
+  o.stereo.free_margin_sigmas = cfg.get_in("stereo.free_margin_sigmas", o.stereo.free_margin_sigmas, 0.0, 100.0);
   o.stereo.weight_hits = cfg.get("stereo.weight_hits", o.stereo.weight_hits);
-  o.visibility_if_occluded = cfg.get("visibility_if_occluded", o.visibility_if_occluded);
+  o.visibility_if_occluded = cfg.get_in("visibility_if_occluded", o.visibility_if_occluded, 0.0, 1.0);
   try {
     o.validate();
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(cfg.origin() + ": " + e.what());
   }
-  c.distance_max = cfg.get("distance_map.max_distance", c.distance_max);
-  c.distance_max_cells = static_cast<size_t>(cfg.get<int64_t>("distance_map.max_cells", static_cast<int64_t>(c.distance_max_cells)));
-  c.publish_period_s = cfg.get("publish.period_s", c.publish_period_s);
-  c.full_every = cfg.get("publish.full_every", c.full_every);
+  c.distance_max = cfg.get_in("distance_map.max_distance", c.distance_max, 0.01, 100.0);
+  c.distance_max_cells = static_cast<size_t>(
+      cfg.get_in<int64_t>("distance_map.max_cells", static_cast<int64_t>(c.distance_max_cells), 1, int64_t{1} << 28));
+  c.publish_period_s = cfg.get_in("publish.period_s", c.publish_period_s, 0.0, 3600.0);
+  c.full_every = cfg.get_in("publish.full_every", c.full_every, 1, 1000000);
   c.publish_binary = cfg.get("publish.binary", c.publish_binary);
-  c.pose_tolerance_us = cfg.get("matching.pose_tolerance_us", c.pose_tolerance_us);
-  c.pose_wait_us = cfg.get("matching.pose_wait_us", c.pose_wait_us);
-  c.max_future_us = cfg.get("matching.max_future_us", c.max_future_us);
-  c.pose_buffer = static_cast<size_t>(cfg.get<int64_t>("matching.pose_buffer", static_cast<int64_t>(c.pose_buffer)));
+  c.pose_tolerance_us = cfg.get_in<int64_t>("matching.pose_tolerance_us", c.pose_tolerance_us, 0, 10000000);
+  c.pose_wait_us = cfg.get_in<int64_t>("matching.pose_wait_us", c.pose_wait_us, 0, 60000000);
+  c.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), c.message_time);
+  c.pose_buffer = static_cast<size_t>(
+      cfg.get_in<int64_t>("matching.pose_buffer", static_cast<int64_t>(c.pose_buffer), 1, 100000));
   c.pose_channel = cfg.get("channels.pose", c.pose_channel);
   c.depth_channel = cfg.get("channels.depth", c.depth_channel);
   c.octomap_channel = cfg.get("channels.octomap", c.octomap_channel);
   c.query_channel = cfg.get("channels.query", c.query_channel);
   c.response_channel = cfg.get("channels.response", c.response_channel);
   c.cmd_channel = cfg.get("channels.cmd", c.cmd_channel);
-  if (!(c.distance_max > 0)) throw std::runtime_error(cfg.origin() + ": distance_map.max_distance must be > 0");
-  if (c.full_every < 1) throw std::runtime_error(cfg.origin() + ": publish.full_every must be >= 1");
-  if (c.pose_tolerance_us < 0 || c.pose_wait_us < 0 || c.max_future_us <= 0 || c.pose_buffer < 1)
-    throw std::runtime_error(cfg.origin() + ": matching.* must be >= 0 (max_future_us, pose_buffer > 0)");
+  c.files_directory = cfg.get("files.directory", c.files_directory);
   return c;
 }
 
-MapService::MapService(bus::Bus& bus, bus::StatusReporter& status, const MapServiceConfig& config)
+MapService::MapService(bus::Bus& bus, bus::StatusReporter& status, const MapServiceConfig& config,
+                       util::NodeClock now)
     : bus_(bus),
       status_(status),
       config_(config),
       map_(config.occupancy),
-      distances_(config.distance_max, config.distance_max_cells) {
+      distances_(config.distance_max, config.distance_max_cells),
+      now_(std::move(now)),
+      vo_clock_(status, "VO", config.message_time) {
   // Depth frames are large and the update can take tens of ms: a deep queue, and a
   // seq gap count on the subscription tells when LCM still dropped some.
   bus_.subscribe<aerie::pose_t>(config_.pose_channel, [this](const auto& m, const auto& i) { on_pose(m, i); }, 200);
@@ -104,12 +116,17 @@ void MapService::reject(const std::string& counter, const std::string& message) 
   spdlog::warn("{}", message);
 }
 
-bool MapService::accept_time(int64_t utime, const char* what) {
-  if (newest_utime_ >= 0 && utime > newest_utime_ + config_.max_future_us) {
-    reject("future_utime", std::string(what) + " utime " + std::to_string(utime) + " is " +
-                               seconds(utime - newest_utime_) + " ahead of the newest message (limit " +
-                               seconds(config_.max_future_us) + "); dropped");
-    return false;
+bool MapService::accept_time(int64_t utime) {
+  const auto r = vo_clock_.observe(utime, now_());
+  if (!r.accepted()) return false;
+  if (r.verdict == util::MessageClock::Verdict::kResynced) {
+    // A new time base (VO restarted, or came back after an outage): poses and waiting depth of
+    // the old one would match the wrong frames. The map itself is kept.
+    poses_.clear();
+    pending_.clear();
+    newest_utime_ = utime;
+    last_depth_utime_ = -1;
+    last_publish_utime_ = -1;
   }
   newest_utime_ = std::max(newest_utime_, utime);
   return true;
@@ -137,7 +154,7 @@ void MapService::on_pose(const aerie::pose_t& msg, const bus::ReceiveInfo& info)
                                 ": position/orientation not finite or not a unit quaternion; dropped");
     return;
   }
-  if (!accept_time(msg.utime, config_.pose_channel.c_str())) return;
+  if (!accept_time(msg.utime)) return;
   poses_[msg.utime] = *pose;
   while (poses_.size() > config_.pose_buffer) poses_.erase(poses_.begin());
   // Depth frames that were waiting for this pose.
@@ -166,7 +183,7 @@ void MapService::on_depth(const aerie::spherical_depth_t& msg, const bus::Receiv
                                   "; dropped");
     return;
   }
-  if (!accept_time(msg.utime, config_.depth_channel.c_str())) return;
+  if (!accept_time(msg.utime)) return;
   if (msg.utime < last_depth_utime_) status_.count("depth_out_of_order");  // still mapped
   if (const auto vo = vo_pose_at(msg.utime)) {
     status_.count("pose_from_vo");
@@ -327,8 +344,23 @@ aerie::map_response_t MapService::answer(const aerie::map_query_t& q) {
   return r;
 }
 
+bool valid_reply_channel(const std::string& channel, const std::string& response_channel) {
+  if (channel == response_channel) return true;
+  const std::string prefix = response_channel + "_";
+  if (channel.size() <= prefix.size() || channel.size() > prefix.size() + 32 || channel.rfind(prefix, 0) != 0)
+    return false;
+  return std::all_of(channel.begin() + static_cast<std::ptrdiff_t>(prefix.size()), channel.end(),
+                     [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; });
+}
+
 void MapService::on_query(const aerie::map_query_t& q, const bus::ReceiveInfo&) {
   status_.count("queries");
+  if (!q.reply_channel.empty() && !valid_reply_channel(q.reply_channel, config_.response_channel)) {
+    reject("query_reply_refused", config_.query_channel + " seq " + std::to_string(q.seq) + ": reply channel '" +
+                                      q.reply_channel.substr(0, 64) + "' is not " + config_.response_channel +
+                                      " or " + config_.response_channel + "_<1..32 of A-Z a-z 0-9 _>; not answered");
+    return;
+  }
   aerie::map_response_t r;
   try {
     r = answer(q);
@@ -344,6 +376,43 @@ void MapService::on_query(const aerie::map_query_t& q, const bus::ReceiveInfo&) 
   bus_.publish(q.reply_channel.empty() ? config_.response_channel : q.reply_channel, r);
 }
 
+std::filesystem::path MapService::confined(const std::string& name) const {
+  if (config_.files_directory.empty())
+    throw std::invalid_argument("SAVE and LOAD over " + config_.cmd_channel + " are off (files.directory is not set)");
+  const bool plain = !name.empty() && name.size() <= 64 && name[0] != '.' &&
+                     std::all_of(name.begin(), name.end(), [](char ch) {
+                       return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.';
+                     });
+  const std::string ext = std::filesystem::path(name).extension().string();
+  if (!plain || (ext != ".bt" && ext != ".ot"))
+    throw std::invalid_argument("'" + name.substr(0, 80) + "' is not a plain map file name in " + config_.files_directory +
+                                " (letters, digits, '_', '-', '.', at most 64, not starting with '.', ending .bt or .ot)");
+  return std::filesystem::path(config_.files_directory) / name;
+}
+
+std::string MapService::save_in_directory(const std::string& name) const {
+  const std::filesystem::path first = confined(name);
+  std::filesystem::create_directories(config_.files_directory);
+  const std::string stem = first.stem().string(), ext = first.extension().string();
+  for (int version = 0; version <= 1000; ++version) {
+    const std::filesystem::path p =
+        version == 0 ? first : first.parent_path() / (stem + "-" + std::to_string(version) + ext);
+    std::error_code ec;
+    if (std::filesystem::exists(std::filesystem::symlink_status(p, ec))) continue;  // never overwritten
+    if (map_.save_new(p.string())) return p.string();  // false: taken meanwhile, try the next version
+  }
+  throw std::runtime_error("map: 1000 versions of '" + name + "' exist in " + config_.files_directory);
+}
+
+void MapService::load_from_directory(const std::string& name) {
+  const std::filesystem::path p = confined(name);
+  std::error_code ec;
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(p, ec)))
+    throw std::invalid_argument("'" + p.string() + "' is a symbolic link; LOAD reads only files in " +
+                                config_.files_directory);
+  load(p.string());
+}
+
 void MapService::load(const std::string& path) {
   map_.load(path);
   unpublished_.reset();
@@ -355,14 +424,14 @@ void MapService::on_cmd(const aerie::map_cmd_t& c, const bus::ReceiveInfo&) {
   status_.count("commands");
   try {
     switch (c.command) {
-      case aerie::map_cmd_t::SAVE:
-        if (c.path.empty()) throw std::invalid_argument("SAVE needs a path (.bt or .ot)");
-        map_.save(c.path);
-        spdlog::info("saved map to '{}'", c.path);
+      case aerie::map_cmd_t::SAVE: {
+        const std::string written = save_in_directory(c.path);
+        status_.ok("saved the map to '" + written + "'");
+        spdlog::info("saved map to '{}'", written);
         break;
+      }
       case aerie::map_cmd_t::LOAD:
-        if (c.path.empty()) throw std::invalid_argument("LOAD needs a path (.bt or .ot)");
-        load(c.path);
+        load_from_directory(c.path);
         break;
       case aerie::map_cmd_t::CLEAR:
         map_.clear();

@@ -11,13 +11,16 @@
 
 #include <cstdint>
 #include <deque>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
 
 #include "common/bus/bus.hpp"
+#include "common/bus/input_clock.hpp"
 #include "common/bus/status.hpp"
 #include "common/util/config.hpp"
+#include "common/util/time.hpp"
 #include "ground/map/distance_map.hpp"
 #include "ground/map/occupancy.hpp"
 
@@ -32,30 +35,51 @@ struct MapServiceConfig {
   bool publish_binary = true;                // publish.binary: .bt stream (else .ot with probabilities)
   int64_t pose_tolerance_us = 1000;          // matching.pose_tolerance_us: |utime difference| to match
   int64_t pose_wait_us = 500000;             // matching.pose_wait_us: a depth without pose waits this long
-  int64_t max_future_us = 10000000;          // matching.max_future_us: newer than the newest by more: rejected
   size_t pose_buffer = 400;                  // matching.pose_buffer: VO_POSE messages kept for matching
+  // message_time.*: VO_POSE and VO_DEPTH are one source (the camera frames behind aerie-vo):
+  // jumps beyond max_jump_s are held until resync_messages consistent ones re-synchronise;
+  // no message for stale_timeout_s (wall clock) reports the source stale.
+  util::MessageClockConfig message_time;
   std::string pose_channel = "VO_POSE";      // channels.*
   std::string depth_channel = "VO_DEPTH";
   std::string octomap_channel = "MAP_OCTOMAP";
   std::string query_channel = "MAP_QUERY";
   std::string response_channel = "MAP_RESPONSE";
   std::string cmd_channel = "MAP_CMD";
+  // files.directory: the only directory MAP_CMD SAVE and LOAD touch; their path must be a
+  // plain file name in it (no '/', no "..", not hidden, .bt or .ot, at most 64 characters)
+  // and LOAD refuses a symlink. "" = SAVE and LOAD over LCM are refused.
+  std::string files_directory;
 
   // Reads config/map.yaml keys (see the file); missing keys keep their defaults.
   static MapServiceConfig from_config(const util::Config& cfg);
 };
 
+// MAP_QUERY replies go to channels.response, or to channels.response + "_" + a suffix of
+// 1..32 letters, digits or '_' (MAP_RESPONSE_PILOT): never to another node's channel.
+bool valid_reply_channel(const std::string& channel, const std::string& response_channel);
+
 class MapService {
  public:
-  MapService(bus::Bus& bus, bus::StatusReporter& status, const MapServiceConfig& config);
+  // `now` is the node's clock for staleness (wall clock live; tests pass their own).
+  MapService(bus::Bus& bus, bus::StatusReporter& status, const MapServiceConfig& config,
+             util::NodeClock now = util::wall_utime);
 
   OccupancyMap& map() { return map_; }
   const MapServiceConfig& config() const { return config_; }
+  // Reports the VO source stale when nothing came for message_time.stale_timeout_s (node clock: wall).
+  void tick() { vo_clock_.check(now_()); }
   // Publishes the whole map now (MAP_CMD PUBLISH_FULL does this too).
   void publish_full(int64_t utime);
   // Saves the map (.bt or .ot); throws std::runtime_error.
   void save(const std::string& path) const { map_.save(path); }
+  // Replaces the map with a checked one from a file (read_octree_file); the old map stays on failure.
   void load(const std::string& path);
+  // MAP_CMD SAVE: a new file in files.directory, never an existing one: `name` when it is
+  // free, else `<stem>-1<ext>`, `<stem>-2<ext>`, ... Returns the path written.
+  std::string save_in_directory(const std::string& name) const;
+  // MAP_CMD LOAD: `name` in files.directory.
+  void load_from_directory(const std::string& name);
 
   // Encodes the map, or the part inside `region`, as an octomap_t.
   aerie::octomap_t encode(int64_t utime, const std::optional<Region>& region);
@@ -66,14 +90,17 @@ class MapService {
   void on_query(const aerie::map_query_t& msg, const bus::ReceiveInfo& info);
   void on_cmd(const aerie::map_cmd_t& msg, const bus::ReceiveInfo& info);
 
-  // False (and counted) when utime is too far ahead of the newest message seen.
-  bool accept_time(int64_t utime, const char* what);
+  // The message-time policy (bus::InputClock): false when the message is held as a jump; on a
+  // re-synchronisation the poses and pending depth of the old time base are dropped.
+  bool accept_time(int64_t utime);
   std::optional<geometry::SE3> vo_pose_at(int64_t utime) const;
   void insert(const spherical::SphericalDepth& depth, int64_t utime, const geometry::SE3& T_world_camera,
               int64_t receive_utime);
   void expire_pending();
   void maybe_publish(int64_t utime);
   aerie::map_response_t answer(const aerie::map_query_t& q);
+  // files.directory / name, after checking name; throws std::invalid_argument.
+  std::filesystem::path confined(const std::string& name) const;
   void reject(const std::string& counter, const std::string& message);
 
   bus::Bus& bus_;
@@ -83,6 +110,8 @@ class MapService {
   DistanceMap distances_;
   std::map<int64_t, geometry::SE3> poses_;         // VO_POSE by utime
   std::deque<std::pair<int64_t, spherical::SphericalDepth>> pending_;  // (utime, depth) waiting for VO_POSE
+  util::NodeClock now_;
+  bus::InputClock vo_clock_;                       // VO_POSE + VO_DEPTH: one time base
   int64_t newest_utime_ = -1;                      // newest accepted message time
   int64_t last_depth_utime_ = -1;
   int64_t last_publish_utime_ = -1;

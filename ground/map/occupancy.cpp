@@ -2,8 +2,12 @@
 
 #include <octomap/AbstractOcTree.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -178,8 +182,11 @@ struct OccupancyMap::FrameBuffer {
 };
 
 void OccupancyParams::validate() const {
-  require(std::isfinite(resolution) && resolution > 0, "resolution must be > 0");
-  require(sensor_model.max_range > 0, "sensor_model/max_range must be > 0");
+  require(resolution >= kMinResolution && resolution <= kMaxResolution,
+          "resolution must be in [" + std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) +
+              "] m, got " + std::to_string(resolution));
+  require(sensor_model.max_range > 0 && sensor_model.max_range <= kMaxRange,
+          "sensor_model/max_range must be in (0, " + std::to_string(kMaxRange) + "] m");
   require(sensor_model.hit > 0.5 && sensor_model.hit < 1, "sensor_model/hit must be in (0.5, 1)");
   require(sensor_model.miss > 0 && sensor_model.miss < 0.5, "sensor_model/miss must be in (0, 0.5)");
   require(sensor_model.min > 0 && sensor_model.min < 0.5 && sensor_model.max > 0.5 && sensor_model.max < 1,
@@ -416,19 +423,43 @@ RayQuery OccupancyMap::cast_ray(const Eigen::Vector3d& origin, const Eigen::Vect
   return q;
 }
 
-void OccupancyMap::save(const std::string& path) const {
+namespace {
+// Writes the tree next to `path` (path + ".part"); returns that file's name.
+std::string write_part(const MapTree& tree, const std::string& path) {
   const std::string ext = extension_of(path);
   if (ext != ".bt" && ext != ".ot")
     throw std::runtime_error("map: cannot save '" + path + "': the extension must be .bt or .ot");
-  // Write next to the target and rename, so that an interrupted save never leaves a truncated map.
   const std::string tmp = path + ".part";
-  const bool ok = ext == ".bt" ? tree_->writeBinaryConst(tmp) : tree_->write(tmp);
-  std::error_code ec;
-  if (ok) std::filesystem::rename(tmp, path, ec);
-  if (!ok || ec) {
+  const bool ok = ext == ".bt" ? tree.writeBinaryConst(tmp) : tree.write(tmp);
+  if (!ok) {
+    std::error_code ec;
     std::filesystem::remove(tmp, ec);
     throw std::runtime_error("map: cannot write '" + path + "'");
   }
+  return tmp;
+}
+}  // namespace
+
+void OccupancyMap::save(const std::string& path) const {
+  // Write next to the target and rename, so that an interrupted save never leaves a truncated map.
+  const std::string tmp = write_part(*tree_, path);
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error("map: cannot write '" + path + "'");
+  }
+}
+
+bool OccupancyMap::save_new(const std::string& path) const {
+  const std::string tmp = write_part(*tree_, path);
+  const int rc = ::link(tmp.c_str(), path.c_str());  // fails with EEXIST instead of replacing
+  const int err = errno;
+  std::error_code ec;
+  std::filesystem::remove(tmp, ec);
+  if (rc == 0) return true;
+  if (err == EEXIST) return false;
+  throw std::runtime_error("map: cannot write '" + path + "': " + std::strerror(err));
 }
 
 namespace {
@@ -450,11 +481,33 @@ class QuietCerr {
 };
 }  // namespace
 
+namespace {
+// What read_octree promises of a tree (see occupancy.hpp); throws std::invalid_argument.
+void check_tree(const octomap::OcTree& tree, std::istream& in, const char* what) {
+  const double res = tree.getResolution();
+  if (!(res >= kMinResolution && res <= kMaxResolution))
+    throw std::invalid_argument(std::string(what) + " of resolution " + std::to_string(res) + " m, outside [" +
+                                std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) + "] m");
+  if (in.peek() != std::char_traits<char>::eof())
+    throw std::invalid_argument(std::string(what) + " followed by bytes that are not part of the tree");
+  if (tree.size() > kMaxMapNodes)
+    throw std::invalid_argument(std::string(what) + " of " + std::to_string(tree.size()) + " nodes, more than " +
+                                std::to_string(kMaxMapNodes));
+  for (auto it = tree.begin_tree(), end = tree.end_tree(); it != end; ++it) {
+    const float l = it->getLogOdds();
+    if (!(std::abs(l) <= kMaxLogOdds))
+      throw std::invalid_argument(std::string(what) + " with a node of log-odds " + std::to_string(l) +
+                                  " (not a saved occupancy map: garbage data?)");
+  }
+}
+}  // namespace
+
 std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary) {
   const QuietCerr quiet;
   if (binary) {
     auto tree = std::make_unique<octomap::OcTree>(0.1);  // readBinary sets the resolution it reads
     if (!tree->readBinary(in)) throw std::invalid_argument("not an OctoMap binary (.bt) tree");
+    check_tree(*tree, in, "an OctoMap binary (.bt) tree");
     return tree;
   }
   std::unique_ptr<octomap::AbstractOcTree> any(octomap::AbstractOcTree::read(in));
@@ -462,7 +515,9 @@ std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary) {
   auto* tree = dynamic_cast<octomap::OcTree*>(any.get());
   if (tree == nullptr) throw std::invalid_argument("a " + any->getTreeType() + ", not an OcTree");
   any.release();
-  return std::unique_ptr<octomap::OcTree>(tree);
+  std::unique_ptr<octomap::OcTree> out(tree);
+  check_tree(*out, in, "an OctoMap (.ot) tree");
+  return out;
 }
 
 std::unique_ptr<octomap::OcTree> read_octree_file(const std::string& path) {

@@ -33,6 +33,14 @@
 
 namespace aerie::map {
 
+// Sane bounds of a map (config/map.yaml, --resolution, --max-range and maps loaded from
+// files): OctoMap's 16-bit keys span 65536 voxels per axis, so 1 cm still maps +-327 m.
+inline constexpr double kMinResolution = 0.01;  // m
+inline constexpr double kMaxResolution = 10.0;  // m
+inline constexpr double kMaxRange = 1000.0;     // m, sensor_model/max_range
+inline constexpr size_t kMaxMapNodes = size_t{1} << 27;  // nodes of a map read from a file or message
+inline constexpr float kMaxLogOdds = 40.f;      // |log-odds| of any node (OctoMap clamps to about +-3.5)
+
 // The parameters of thesis section 4.2.2 (OctoMap names) plus the stereo error model.
 struct OccupancyParams {
   double resolution = 0.1;  // m, finest voxel
@@ -67,7 +75,10 @@ struct OccupancyParams {
 
 // An OctoMap OcTree, at its own resolution, from the content of a .bt file (`binary`:
 // occupied/free) or a .ot file (full probabilities). Throws std::invalid_argument saying
-// what the content is instead ("not an OctoMap binary (.bt) tree", ...).
+// what the content is instead ("not an OctoMap binary (.bt) tree", ...). The tree is
+// checked before it is returned: resolution in [kMinResolution, kMaxResolution], the
+// stream used up exactly (no bytes after the tree), at most kMaxMapNodes nodes, every
+// log-odds finite and within +-kMaxLogOdds (a garbage body parses as random floats).
 std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary);
 // The same from a file, .bt or .ot by extension. Throws std::runtime_error naming the path.
 std::unique_ptr<octomap::OcTree> read_octree_file(const std::string& path);
@@ -131,6 +142,9 @@ class OccupancyMap {
   // .bt (binary: occupied/free only) or .ot (full probabilities), chosen by extension.
   // Throws std::runtime_error naming the path.
   void save(const std::string& path) const;
+  // As save(), but never replaces an existing file (atomic: link(2) of the written file):
+  // false when `path` exists.
+  bool save_new(const std::string& path) const;
   // Replaces the map with a saved one (its resolution replaces params.resolution).
   void load(const std::string& path);
   void clear();

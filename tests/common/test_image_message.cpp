@@ -79,3 +79,34 @@ TEST(ImageMessage, BadMessagesAreRejectedWithAReason) {
   EXPECT_THROW(to_message(cv::Mat(), 0, 0), std::invalid_argument);
   EXPECT_THROW(encoding_from_string("gif"), std::invalid_argument);
 }
+
+TEST(ImageMessage, DeclaredSizeIsCheckedBeforeDecoding) {
+  const cv::Mat img(48, 64, CV_8UC1, cv::Scalar(128));
+  for (auto enc : {Encoding::Png, Encoding::Jpeg}) {
+    aerie::image_t m = to_message(img, 1, 1, enc);
+    const auto declared = encoded_size(m.data.data(), m.data.size(), enc == Encoding::Png);
+    ASSERT_TRUE(declared.has_value());
+    EXPECT_EQ(*declared, cv::Size(64, 48));
+    // The message claims less than the payload declares: refused, naming both, not decoded.
+    m.width = 32;
+    m.height = 24;
+    try {
+      from_message(m);
+      FAIL();
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("payload declares 64x48, header says 32x24 (not decoded)"), std::string::npos)
+          << e.what();
+    }
+    // A cap below the image's size.
+    m = to_message(img, 1, 1, enc);
+    try {
+      from_message(m, 64 * 48 - 1);
+      FAIL();
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("64x48 is larger than the limit of 3071 pixels"), std::string::npos) << e.what();
+    }
+  }
+  const uint8_t junk[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+  EXPECT_FALSE(encoded_size(junk, sizeof junk, true).has_value());
+  EXPECT_FALSE(encoded_size(junk, sizeof junk, false).has_value());
+}

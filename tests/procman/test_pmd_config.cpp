@@ -177,3 +177,34 @@ TEST(PmdConfig, ShippedConfigsParse) {
   }
   EXPECT_EQ(load_pmd((aerie::test::source_dir() / "config/split.pmd").string()).hosts().size(), 2u);
 }
+
+TEST(PmdConfig, NestingDepthIsBoundedWithAClearError) {
+  // The reproducers: 20,000 nested groups and 50,000 chained run_script overflowed the stack.
+  std::string groups = "cmd \"x\" { exec = \"true\"; host = \"h\"; }\n";
+  for (int i = 0; i < 20000; ++i) groups += "group \"g" + std::to_string(i) + "\" {\n";
+  groups += "cmd \"y\" { exec = \"true\"; host = \"h\"; }\n";
+  for (int i = 0; i < 20000; ++i) groups += "}\n";
+  expect_error(groups, 34, 1, "groups nested more than 32 deep");
+  std::string chain = "cmd \"x\" { exec = \"true\"; host = \"h\"; }\n";
+  for (int i = 0; i < 50000; ++i)
+    chain += "script \"s" + std::to_string(i) + "\" { run_script \"s" + std::to_string(i + 1) + "\"; }\n";
+  chain += "script \"s50000\" { start cmd \"x\"; }\n";
+  expect_error(chain, 33, 16, "run_script \"s32\" chains scripts more than 32 deep");
+  // Two chains of 20 checked one after the other: the second ends in the first, 40 deep.
+  std::string late = "cmd \"x\" { exec = \"true\"; host = \"h\"; }\n";
+  for (int i = 1; i < 20; ++i)
+    late += "script \"s" + std::to_string(i) + "\" { run_script \"s" + std::to_string(i + 1) + "\"; }\n";
+  late += "script \"s20\" { start cmd \"x\"; }\n";
+  for (int i = 1; i < 20; ++i)
+    late += "script \"a" + std::to_string(i) + "\" { run_script \"a" + std::to_string(i + 1) + "\"; }\n";
+  late += "script \"a20\" { run_script \"s1\"; }\n";
+  expect_error(late, 41, 16, "run_script \"s1\" chains scripts more than 32 deep");
+  // 32 levels of each are fine.
+  std::string ok = "cmd \"x\" { exec = \"true\"; host = \"h\"; }\n";
+  for (int i = 0; i < 31; ++i) ok += "group \"g" + std::to_string(i) + "\" {\n";
+  ok += "cmd \"y\" { exec = \"true\"; host = \"h\"; }\n";
+  for (int i = 0; i < 31; ++i) ok += "}\n";
+  for (int i = 0; i < 31; ++i) ok += "script \"s" + std::to_string(i) + "\" { run_script \"s" + std::to_string(i + 1) + "\"; }\n";
+  ok += "script \"s31\" { start cmd \"x\"; }\n";
+  EXPECT_NO_THROW(parse_pmd(ok));
+}

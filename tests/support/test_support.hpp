@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace aerie::test {
 
@@ -26,6 +28,26 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+// What `load(text)` throws, or "" when it accepts the text.
+template <typename Load>
+std::string refusal(Load&& load, const std::string& text) {
+  try {
+    load(text);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return {};
+}
+
+// Each (config text, expected words) case must be refused with a message holding the words.
+template <typename Load>
+void expect_refusals(Load&& load, const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (const auto& [text, why] : cases) {
+    const std::string e = refusal(load, text);
+    EXPECT_NE(e.find(why), std::string::npos) << text << " -> " << (e.empty() ? "accepted" : e);
+  }
 }
 
 }  // namespace aerie::test

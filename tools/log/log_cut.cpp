@@ -6,13 +6,16 @@
 
 namespace aerie::logtools {
 
-CutResult cut(const std::string& in_path, double from_s, double to_s, const std::string& out_path, bool resync) {
+CutResult cut(const std::string& in_path, double from_s, double to_s, const std::string& out_path, bool resync,
+              bool force) {
   if (!(from_s >= 0) || !(to_s > from_s))
     throw std::invalid_argument("cut: need 0 <= --from < --to (got " + std::to_string(from_s) + ", " +
                                 std::to_string(to_s) + ")");
   std::error_code ec;
   if (std::filesystem::equivalent(in_path, out_path, ec))
     throw std::invalid_argument("cut: the output " + out_path + " is the input log");
+  if (!force && std::filesystem::exists(std::filesystem::symlink_status(out_path, ec)))
+    throw std::invalid_argument("cut: the output " + out_path + " exists; pass --force to overwrite it");
   logio::Reader reader(in_path, {.resync = resync});
   logio::Writer writer(out_path);
   CutResult r;

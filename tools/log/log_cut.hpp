@@ -17,8 +17,9 @@ struct CutResult {
 };
 
 // Keeps events with from_s <= (utime - first utime) / 1e6 < to_s. Throws
-// std::invalid_argument for an empty range and std::runtime_error naming the file on I/O errors.
+// std::invalid_argument for an empty range or an existing output (unless `force`: recorded
+// data is never overwritten by mistake) and std::runtime_error naming the file on I/O errors.
 CutResult cut(const std::string& in_path, double from_s, double to_s, const std::string& out_path,
-              bool resync = false);
+              bool resync = false, bool force = false);
 
 }  // namespace aerie::logtools

@@ -179,7 +179,12 @@ std::unique_ptr<Exporter> make_exporter(const std::string& type, const std::stri
 }  // namespace
 
 ExportResult export_channel(const std::string& log_path, const std::string& channel, const std::string& out_dir,
-                            bool resync) {
+                            bool resync, bool force) {
+  std::error_code ec;
+  if (!force && fs::exists(fs::symlink_status(out_dir, ec)) &&
+      !(fs::is_directory(out_dir, ec) && fs::is_empty(out_dir, ec)))
+    throw std::runtime_error("export: the output " + out_dir + " exists and is not an empty folder; pass --force to "
+                             "write over the files in it");
   logio::Reader reader(log_path, {.resync = resync});
   ExportResult r;
   std::unique_ptr<Exporter> exporter;

@@ -23,9 +23,10 @@ struct ExportResult {
 };
 
 // Throws std::runtime_error naming the log/channel when the channel is absent or its
-// type cannot be exported, or naming the file when an output cannot be written.
+// type cannot be exported, or naming the file when an output cannot be written. out_dir
+// must not exist or be empty, unless `force` (then files of the same names are overwritten).
 ExportResult export_channel(const std::string& log_path, const std::string& channel, const std::string& out_dir,
-                            bool resync = false);
+                            bool resync = false, bool force = false);
 
 // "1403715273.262143" for utime 1403715273262143: exact, no floating point.
 std::string utime_to_seconds(int64_t utime);

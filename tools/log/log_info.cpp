@@ -91,7 +91,14 @@ LogSummary summarize(const std::string& path, bool resync) {
     const std::string type_name = type ? type->name : "unknown (fingerprint " + hex64(fp) + ")";
     if (std::find(a.types.begin(), a.types.end(), type_name) == a.types.end()) a.types.push_back(type_name);
     if (!type) continue;
-    const Stamp st = type->decode(ev.data.data(), ev.data.size());
+    Stamp st;
+    try {
+      st = type->decode(ev.data.data(), ev.data.size());
+    } catch (const std::exception& e) {  // a decoder that throws: the payload is corrupt, the log goes on
+      st = Stamp{};
+      out.notes.push_back(path + ": event " + std::to_string(ev.event_number) + " on " + ev.channel + " (" +
+                          type_name + "): " + e.what());
+    }
     if (!st.decoded) {
       ++c.undecodable;
       ++a.undecodable_since_seq;
@@ -147,7 +154,10 @@ void print_summary(const LogSummary& s, std::ostream& out) {
   out << "\n";
   for (const auto& c : s.channels)
     if (c.seq_restarts) out << "note: " << c.channel << ": sequence restarted " << c.seq_restarts << " time(s)\n";
-  if (s.damage.empty()) {
+  for (const auto& n : s.notes) out << "note: " << n << "\n";
+  if (s.events == 0 && s.damage.empty()) {
+    out << "empty:    the log holds no events\n";
+  } else if (s.damage.empty()) {
     out << "damage:   none\n";
   } else {
     for (const auto& d : s.damage) out << "DAMAGE:   " << d.message << "\n";

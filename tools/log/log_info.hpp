@@ -35,6 +35,7 @@ struct LogSummary {
   int64_t event_number_gaps = 0;  // events missing by the logger's own numbering
   std::vector<ChannelSummary> channels;  // sorted by name
   std::vector<logio::Damage> damage;
+  std::vector<std::string> notes;  // payloads whose decoder threw: file, event number, channel, why
 
   int64_t dropped() const;  // sum of seq_gaps
 };

@@ -1,7 +1,7 @@
 // aerie-log: inspect, export and cut LCM event logs (the lcm-logger format).
 //   aerie-log info LOG [--json] [--resync]
-//   aerie-log export LOG --channel C --out DIR [--resync]
-//   aerie-log cut LOG --from S --to S --out LOG2 [--resync]
+//   aerie-log export LOG --channel C --out DIR [--resync] [--force]
+//   aerie-log cut LOG --from S --to S --out LOG2 [--resync] [--force]
 // Exit status: 0 ok, 1 error (bad arguments, missing file/channel), 2 the log is
 // damaged (everything before the damage was still processed, and it is reported).
 #include <CLI/CLI.hpp>
@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Inspect, export and cut LCM event logs (lcm-logger format)", "aerie-log"};
   app.require_subcommand(1);
   std::string log, channel, out;
-  bool json = false, resync = false;
+  bool json = false, resync = false, force = false;
   double from_s = 0, to_s = std::numeric_limits<double>::infinity();
 
   auto* info = app.add_subcommand("info", "Channels, types, counts, rates, gaps, dropped messages, duration");
@@ -47,6 +47,8 @@ int main(int argc, char** argv) {
 
   for (auto* sub : {info, exp, cut})
     sub->add_flag("--resync", resync, "Skip damaged bytes to the next event header instead of stopping there");
+  for (auto* sub : {exp, cut})
+    sub->add_flag("--force", force, "Overwrite an existing output (refused otherwise)");
 
   CLI11_PARSE(app, argc, argv);
   try {
@@ -60,14 +62,14 @@ int main(int argc, char** argv) {
       return s.damage.empty() ? 0 : 2;
     }
     if (*exp) {
-      const auto r = aerie::logtools::export_channel(log, channel, out, resync);
+      const auto r = aerie::logtools::export_channel(log, channel, out, resync, force);
       std::cout << "exported " << r.exported << " " << r.type << " messages of " << channel << " to:\n";
       for (const auto& o : r.outputs) std::cout << "  " << o << "\n";
       if (r.undecodable) std::cout << "skipped " << r.undecodable << " undecodable messages\n";
       if (r.other_type) std::cout << "skipped " << r.other_type << " messages of another type\n";
       return report_damage(r.damage);
     }
-    const auto r = aerie::logtools::cut(log, from_s, to_s, out, resync);
+    const auto r = aerie::logtools::cut(log, from_s, to_s, out, resync, force);
     std::cout << "wrote " << r.events_written << " of " << r.events_read << " events to " << out << "\n";
     return report_damage(r.damage);
   } catch (const std::exception& e) {

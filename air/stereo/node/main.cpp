@@ -35,7 +35,10 @@ int main(int argc, char** argv) {
     aerie::bus::StatusReporter status(bus, "VO");
     aerie::stereo::VoNode node(bus, status, cfg);
     spdlog::info("{} -> {}{}", cfg.input, cfg.pose, cfg.depth.empty() ? "" : ", " + cfg.depth);
-    aerie::bus::run(bus, status);
+    aerie::bus::run(bus, status, [&] {
+      node.tick();  // reports the camera stale during an outage
+      return true;
+    });
     spdlog::info("stopped after {} stereo pairs ({} refused)", node.processed(), node.refused());
     return 0;
   } catch (const std::exception& e) {

@@ -16,7 +16,8 @@ namespace aerie::stereo {
 
 VoNodeConfig load_vo_node_config(const util::Config& cfg) {
   VoNodeConfig c;
-  c.vo = vo_params_from_config(cfg, {"node"});
+  c.vo = vo_params_from_config(cfg, kNodeSections);
+  c.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), c.message_time);
   const util::Config n = cfg.section("node");
   c.input = n.get<std::string>("input", c.input);
   c.pose = n.get<std::string>("pose", c.pose);
@@ -25,21 +26,15 @@ VoNodeConfig load_vo_node_config(const util::Config& cfg) {
   c.spherical_resolution_deg = n.get<double>("spherical_resolution_deg", c.spherical_resolution_deg);
   c.spherical_max_range_m = n.get<double>("spherical_max_range_m", c.spherical_max_range_m);
   c.queue = n.get<int>("queue", c.queue);
-  for (const auto& kv : n.node()) {
-    static const char* known[] = {"input", "pose", "depth", "max_pair_skew_us", "spherical_resolution_deg",
-                                  "spherical_max_range_m", "queue"};
-    const auto key = kv.first.as<std::string>();
-    if (std::find(std::begin(known), std::end(known), key) == std::end(known))
-      throw std::runtime_error(cfg.origin() + ": unknown key 'node." + key + "'");
-  }
+  n.check_keys({"input", "pose", "depth", "max_pair_skew_us", "spherical_resolution_deg", "spherical_max_range_m", "queue"});
   if (c.input.empty() || c.pose.empty()) throw std::runtime_error(cfg.origin() + ": node.input and node.pose are required");
   if (c.max_pair_skew_us < 0 || c.queue < 1 || !(c.spherical_resolution_deg > 0) || !(c.spherical_max_range_m > 0))
     throw std::runtime_error(cfg.origin() + ": node.max_pair_skew_us >= 0, node.queue >= 1 and positive spherical_*");
   return c;
 }
 
-VoNode::VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg)
-    : bus_(bus), status_(status), cfg_(cfg) {
+VoNode::VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg, util::NodeClock now)
+    : bus_(bus), status_(status), cfg_(cfg), now_(std::move(now)), camera_clock_(status, cfg.input, cfg.message_time) {
   cfg_.vo.validate();
   bus_.subscribe<aerie::stereo_image_t>(
       cfg_.input, [this](const aerie::stereo_image_t& m, const bus::ReceiveInfo& info) { on_stereo(m, info.recv_utime); },
@@ -77,6 +72,14 @@ void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
     spdlog::warn("refused stereo pair: {}", e.what());
     return;
   }
+  // The message-time policy: a pair whose time jumps is held (counted "<input>.time_jumps");
+  // a re-synchronisation (camera restarted or back after an outage) restarts the odometry.
+  const auto time = camera_clock_.observe(m.utime, now_());
+  if (!time.accepted()) return;
+  if (time.verdict == util::MessageClock::Verdict::kResynced && vo_) {
+    vo_->reset(time.reason);
+    status_.count("time_resets");
+  }
   // A new camera (first pair, or size/intrinsics changed) or time going backwards (a log
   // replayed from the start): start over.
   const StereoCamera cam{m.fx, m.fy, m.cx, m.cy, m.baseline_m, left.cols, left.rows};
@@ -91,7 +94,11 @@ void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
       spherical::EncoderConfig ec;
       ec.angular_resolution_rad = static_cast<float>(cfg_.spherical_resolution_deg * M_PI / 180.0);
       ec.max_range_m = static_cast<float>(cfg_.spherical_max_range_m);
-      const cv::Size depth_size((cam.width + s - 1) / s, (cam.height + s - 1) / s);
+      // The dense map's size: vo.cpp halves the pair with cv::resize(..., 0.5, 0.5), whose
+      // output is saturate_cast<int>(size * 0.5), rounded half to even (377 -> 188, 379 -> 190).
+      const cv::Size depth_size = s == 1 ? cv::Size(cam.width, cam.height)
+                                         : cv::Size(cv::saturate_cast<int>(cam.width * 0.5),
+                                                    cv::saturate_cast<int>(cam.height * 0.5));
       // Intrinsics of the dense map: pixel (x, y) of a half-resolution map is (2x + 0.5, 2y + 0.5) - 0.5.
       const spherical::Intrinsics k{cam.fx / s, cam.fy / s, (cam.cx + 0.5) / s - 0.5, (cam.cy + 0.5) / s - 0.5,
                                     cam.baseline};
@@ -99,7 +106,7 @@ void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
       spdlog::info("camera {}x{} f {:.1f} px baseline {:.3f} m; dense depth {}x{} every {} pairs", cam.width,
                    cam.height, cam.fx, cam.baseline, depth_size.width, depth_size.height, cfg_.vo.depth_every);
       status_.count("camera_changes");
-    } else if (m.utime <= last_utime_) {
+    } else if (m.utime <= last_utime_ && time.verdict != util::MessageClock::Verdict::kResynced) {
       vo_->reset("time went back from " + std::to_string(last_utime_) + " to " + std::to_string(m.utime));
       status_.count("time_resets");
     }

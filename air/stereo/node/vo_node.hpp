@@ -9,9 +9,11 @@
 
 #include "air/stereo/vo/vo.hpp"
 #include "common/bus/bus.hpp"
+#include "common/bus/input_clock.hpp"
 #include "common/bus/status.hpp"
 #include "common/spherical/spherical_depth.hpp"
 #include "common/util/config.hpp"
+#include "common/util/time.hpp"
 
 namespace aerie::stereo {
 
@@ -24,18 +26,26 @@ struct VoNodeConfig {
   double spherical_resolution_deg = 0.5;
   double spherical_max_range_m = 20.0;
   int queue = 4;
+  // message_time.*: the camera's time (docs/architecture.md "Message time"): jumps are held,
+  // a restart / outage re-synchronises (and restarts the odometry from the last pose), no pair
+  // for stale_timeout_s is reported as "<input> stale".
+  util::MessageClockConfig message_time;
 };
 // config/vo.yaml: the VO keys and the "node" section.
 VoNodeConfig load_vo_node_config(const util::Config& cfg);
 
 class VoNode {
  public:
-  VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg);
+  // `now` is the node's clock for staleness (wall clock live; tests pass theirs).
+  VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg, util::NodeClock now = util::wall_utime);
   ~VoNode();
 
   // Handles one stereo pair (also called by the subscription). Never throws: refused pairs
   // are logged and counted.
   void on_stereo(const aerie::stereo_image_t& msg, int64_t receive_utime);
+
+  // Reports the camera stale when no pair came for message_time.stale_timeout_s.
+  void tick() { camera_clock_.check(now_()); }
 
   int64_t processed() const { return processed_; }
   int64_t refused() const { return refused_; }
@@ -49,6 +59,8 @@ class VoNode {
   bus::Bus& bus_;
   bus::StatusReporter& status_;
   VoNodeConfig cfg_;
+  util::NodeClock now_;
+  bus::InputClock camera_clock_;
   std::unique_ptr<StereoOdometry> vo_;
   std::unique_ptr<spherical::SphericalEncoder> encoder_;
   int64_t last_utime_ = -1;

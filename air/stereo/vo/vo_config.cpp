@@ -1,7 +1,6 @@
 #include "air/stereo/vo/vo_config.hpp"
 
 #include <algorithm>
-#include <functional>
 #include <set>
 #include <stdexcept>
 
@@ -17,20 +16,9 @@ class Reader {
     value = cfg_.get<T>(key, value);
   }
   void check_unknown(const std::vector<std::string>& other_sections) const {
-    std::function<void(const YAML::Node&, const std::string&)> walk = [&](const YAML::Node& n, const std::string& prefix) {
-      for (const auto& kv : n) {
-        const std::string key = prefix.empty() ? kv.first.as<std::string>() : prefix + "." + kv.first.as<std::string>();
-        if (prefix.empty() &&
-            std::find(other_sections.begin(), other_sections.end(), key) != other_sections.end())
-          continue;
-        if (kv.second.IsMap()) {
-          walk(kv.second, key);
-        } else if (!known_.count(key)) {
-          throw std::runtime_error(cfg_.origin() + ": unknown key '" + key + "'");
-        }
-      }
-    };
-    if (cfg_.node() && cfg_.node().IsMap()) walk(cfg_.node(), "");
+    std::vector<std::string> known(known_.begin(), known_.end());
+    for (const auto& s : other_sections) known.push_back(s + ".*");  // read by their own readers
+    cfg_.check_keys(known);
   }
 
  private:

@@ -14,6 +14,12 @@
 namespace aerie::track {
 
 NodeOptions node_options(const util::Config& cfg) {
+  cfg.check_keys({"node.camera_channel", "node.stereo", "node.command_channel", "node.track_channel",
+                  "node.pose_channel", "node.gt_channel", "node.tracker", "node.seed", "node.max_points",
+                  "node.init_from_gt", "target.name", "target.width_m", "target.height_m", "target.yaw_offset_deg",
+                  "target.shape", "target.border", "target.search_margin", "target.reseed_iou", "camera.calibration",
+                  "camera.fx", "camera.fy", "camera.cx", "camera.cy", "camera.width", "camera.height", "trackers.*",
+                  "message_time.*"});
   NodeOptions o;
   const util::Config node = cfg.section("node");
   o.camera_channel = node.get("camera_channel", o.camera_channel);
@@ -24,44 +30,55 @@ NodeOptions node_options(const util::Config& cfg) {
   o.gt_channel = node.get("gt_channel", o.gt_channel);
   o.tracker = node.get("tracker", o.tracker);
   o.seed = node.get<uint64_t>("seed", o.seed);
-  o.max_points = node.get("max_points", o.max_points);
-  o.init_from_gt = node.get("init_from_gt", o.init_from_gt);
+  o.max_points = node.get_in("max_points", o.max_points, 0, 100000);
+  o.init_from_gt = node.get_in("init_from_gt", o.init_from_gt, -1, 1000000);
+  o.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), o.message_time);
   if (!is_known_tracker(o.tracker))
     throw std::runtime_error(cfg.origin() + ": node.tracker: unknown tracker '" + o.tracker + "'");
-  if (o.max_points < 0) throw std::runtime_error(cfg.origin() + ": node.max_points must be >= 0");
 
   const util::Config target = cfg.section("target");
   o.target_name = target.get("name", o.target_name);
-  o.target.width_m = target.get("width_m", 0.0);
-  o.target.height_m = target.get("height_m", o.target.width_m);
-  o.target.yaw_offset = target.get("yaw_offset_deg", 0.0) * M_PI / 180;
-  if (o.target.width_m < 0 || o.target.height_m < 0)
-    throw std::runtime_error(cfg.origin() + ": target.width_m and target.height_m must be >= 0");
+  o.target.width_m = target.get_in("width_m", 0.0, 0.0, 1000.0);
+  o.target.height_m = target.get_in("height_m", o.target.width_m, 0.0, 1000.0);
+  o.target.yaw_offset = target.get_in("yaw_offset_deg", 0.0, -360.0, 360.0) * M_PI / 180;
   const std::string shape = target.get<std::string>("shape", "box");
   if (shape != "box" && shape != "square")
     throw std::runtime_error(cfg.origin() + ": target.shape must be box or square, got '" + shape + "'");
   o.target_shape = shape == "square" ? TargetShape::Square : TargetShape::Box;
   o.pad_border = target.get("border", o.pad_border);
-  o.search_margin = target.get("search_margin", o.search_margin);
-  o.reseed_iou = target.get("reseed_iou", o.reseed_iou);
+  o.search_margin = target.get_in("search_margin", o.search_margin, 0.0, 10.0);
+  o.reseed_iou = target.get_in("reseed_iou", o.reseed_iou, 0.0, 1.0);
   if (!(o.pad_border >= 0 && o.pad_border < 0.25)) throw std::runtime_error(cfg.origin() + ": target.border must be in [0, 0.25)");
-  if (!(o.search_margin >= 0)) throw std::runtime_error(cfg.origin() + ": target.search_margin must be >= 0");
-  if (!(o.reseed_iou >= 0 && o.reseed_iou <= 1)) throw std::runtime_error(cfg.origin() + ": target.reseed_iou must be in [0, 1]");
 
   const util::Config cam = cfg.section("camera");
   if (cam.has("calibration")) {
     o.camera = camera::read_stereo_calibration(cam.require<std::string>("calibration")).left;
   } else if (cam.get("fx", 0.0) > 0) {
     camera::CameraModel m;
-    m.fx = cam.require<double>("fx");
-    m.fy = cam.get("fy", m.fx);
+    m.fx = cam.get_in("fx", 0.0, 0.0, 1e5);
+    m.fy = cam.get_in("fy", m.fx, 0.0, 1e5);
     m.cx = cam.require<double>("cx");
     m.cy = cam.require<double>("cy");
-    m.width = cam.get("width", 0);
-    m.height = cam.get("height", 0);
+    m.width = cam.get_in("width", 0, 0, 16384);
+    m.height = cam.get_in("height", 0, 0, 16384);
     o.camera = m;
   }
   o.trackers = cfg.section("trackers");
+  // Every tracker's parameters are checked now, not at the first INIT in flight.
+  if (o.trackers.node() && !o.trackers.node().IsNull()) {
+    if (!o.trackers.node().IsMap()) throw std::runtime_error(o.trackers.origin() + ": expected a section per tracker");
+    for (const auto& kv : o.trackers.node()) {
+      const std::string name = kv.first.Scalar();
+      if (!is_known_tracker(name))
+        throw std::runtime_error(cfg.origin() + ": trackers." + name + ": unknown tracker (line " +
+                                 std::to_string(kv.first.Mark().line + 1) + ")");
+      try {
+        make_tracker(name, o.trackers.section(name), o.seed);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(e.what());
+      }
+    }
+  }
   return o;
 }
 
@@ -96,7 +113,8 @@ double iou(const cv::Rect2d& a, const cv::Rect2d& b) {
 }
 }  // namespace
 
-TrackNode::TrackNode(bus::Bus& bus, NodeOptions options) : bus_(bus), opt_(std::move(options)) {
+TrackNode::TrackNode(bus::Bus& bus, NodeOptions options, util::NodeClock now)
+    : bus_(bus), opt_(std::move(options)), now_(std::move(now)), camera_clock_(opt_.camera_channel, opt_.message_time) {
   if (!is_known_tracker(opt_.tracker)) throw std::invalid_argument("unknown tracker '" + opt_.tracker + "'");
   if (opt_.target_shape == TargetShape::Square) {
     if (!(opt_.target.width_m > 0)) throw std::invalid_argument("target.shape square needs target.width_m > 0 (the pad's side)");
@@ -145,6 +163,19 @@ TrackNode::~TrackNode() {
 void TrackNode::on_frame(Frame frame) {
   std::lock_guard lk(mutex_);
   ++counters_["frames_received"];
+  // The message-time policy, reported under the names bus::InputClock uses.
+  const auto time = camera_clock_.observe(frame.image.utime, now_());
+  if (!time.accepted()) {
+    ++counters_[opt_.camera_channel + ".time_jumps"];
+    error_ = time.reason;
+    error_fresh_ = true;
+    if (camera_clock_.held() <= 10 || camera_clock_.held() % 100 == 0) spdlog::warn("{}", time.reason);
+    return;
+  }
+  if (time.verdict == util::MessageClock::Verdict::kResynced) {
+    ++counters_[opt_.camera_channel + ".time_resyncs"];
+    spdlog::info("{}", time.reason);
+  }
   if (pending_) ++counters_["frames_skipped"];  // latest-frame semantics: the older one is dropped
   pending_ = std::move(frame);
   wake_.notify_one();
@@ -183,6 +214,16 @@ int64_t TrackNode::counter(const std::string& name) const {
 
 void TrackNode::report(bus::StatusReporter& status) {
   std::lock_guard lk(mutex_);
+  const int64_t now = now_();
+  if (const auto change = camera_clock_.stale_change(now)) {
+    stale_message_ = *change;
+    if (!change->empty()) {
+      ++counters_[opt_.camera_channel + ".outages"];
+      spdlog::warn("{}", *change);
+    }
+  }
+  const bool stale = camera_clock_.stale(now);
+  counters_[opt_.camera_channel + ".stale"] = stale ? 1 : 0;
   for (const auto& [name, value] : counters_) status.set(name, value);
   if (error_fresh_) {
     status.warn(error_);
@@ -192,6 +233,7 @@ void TrackNode::report(bus::StatusReporter& status) {
   } else {
     status.ok(tracker_name_.empty() ? "idle" : "tracking with " + tracker_name_);
   }
+  if (stale) status.warn(stale_message_);
   if (hop_source_ != 0) status.mark_hop(hop_source_, hop_receive_, hop_publish_);
 }
 
@@ -216,7 +258,16 @@ void TrackNode::run() {
     bool initialised_now = false;
     if (frame) {
       try {
-        last_frame_ = image::from_message(frame->image);
+        cv::Mat img = image::from_message(frame->image, max_pixels());
+        if (tracker_ && img.size() != last_frame_.size()) {  // the tracker's model is of the old size
+          count("frame_size_changes");
+          fail(opt_.camera_channel + ": frame size changed from " + std::to_string(last_frame_.cols) + "x" +
+               std::to_string(last_frame_.rows) + " to " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+               "; track of " + tracker_name_ + " ended (send INIT again)");
+          tracker_.reset();
+          tracker_name_.clear();
+        }
+        last_frame_ = std::move(img);
         last_camera_ = frame->camera ? frame->camera : opt_.camera;
         ++frames_seen_;
       } catch (const std::exception& e) {
@@ -280,6 +331,12 @@ void TrackNode::run() {
     }
     idle_.notify_all();
   }
+}
+
+int64_t TrackNode::max_pixels() const {
+  if (opt_.camera && opt_.camera->width > 0 && opt_.camera->height > 0)
+    return static_cast<int64_t>(opt_.camera->width) * opt_.camera->height;
+  return image::kMaxPixels;
 }
 
 void TrackNode::start_tracker(const std::string& name, const util::Config& params, const cv::Rect2d& box) {

@@ -32,6 +32,8 @@
 #include "common/bus/bus.hpp"
 #include "common/bus/status.hpp"
 #include "common/util/config.hpp"
+#include "common/util/message_clock.hpp"
+#include "common/util/time.hpp"
 
 namespace aerie::track {
 
@@ -58,6 +60,10 @@ struct NodeOptions {
   double search_margin = 0.5;  // square: the pad is searched in the box grown by this x its size per side
   double reseed_iou = 0.5;     // square: re-initialise the tracker on the pad when their IoU is below (0 = never)
   std::optional<camera::CameraModel> camera;  // intrinsics (stereo messages bring their own)
+  // message_time.*: the camera's time (docs/architecture.md "Message time"): a frame whose utime
+  // jumps is held (never tracked, so a bogus time never reaches TRACK / TARGET_POSE), a restart or
+  // outage re-synchronises, no frame for stale_timeout_s is reported as "<camera> stale".
+  util::MessageClockConfig message_time;
 };
 
 // Reads the "node", "target", "camera" and "trackers" sections of track.yaml; throws naming
@@ -66,13 +72,14 @@ NodeOptions node_options(const util::Config& cfg);
 
 class TrackNode {
  public:
-  TrackNode(bus::Bus& bus, NodeOptions options);
+  // `now` is the node's clock for staleness (wall clock live; tests pass theirs).
+  TrackNode(bus::Bus& bus, NodeOptions options, util::NodeClock now = util::wall_utime);
   ~TrackNode();
   TrackNode(const TrackNode&) = delete;
   TrackNode& operator=(const TrackNode&) = delete;
 
   // Copies the worker's counters, health and last hop into the status reporter (call from
-  // the thread that owns the reporter).
+  // the thread that owns the reporter); a stale camera is reported here (WARN "<camera> stale").
   void report(bus::StatusReporter& status);
   // Blocks until every frame and command received so far is processed (tests); false on timeout.
   bool wait_idle(int timeout_ms);
@@ -93,6 +100,8 @@ class TrackNode {
   std::optional<PadObservation> refine(const TrackState& s);
   void start_tracker(const std::string& name, const util::Config& params, const cv::Rect2d& box);
   void publish(const Frame& frame, const TrackState* state, double ms, const PadObservation* pad = nullptr);
+  // Largest frame decoded: the configured camera's size (camera.width x camera.height), else image::kMaxPixels.
+  int64_t max_pixels() const;
   void count(const std::string& name, int64_t n = 1);
   void fail(const std::string& message);
 
@@ -110,6 +119,9 @@ class TrackNode {
   bool busy_ = false, stop_ = false;
   int64_t hop_source_ = 0, hop_receive_ = 0, hop_publish_ = 0;
   std::deque<aerie::gt_box_t> gt_;  // recent ground-truth boxes (init_from_gt)
+  util::NodeClock now_;
+  util::MessageClock camera_clock_;  // the message-time policy of the camera channel
+  std::string stale_message_;
 
   // Worker state.
   std::deque<aerie::track_cmd_t> deferred_;  // INIT commands waiting for the first frame

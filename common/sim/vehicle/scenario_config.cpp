@@ -3,21 +3,14 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace aerie::sim {
 
 void require_known_keys(const util::Config& section, std::initializer_list<const char*> allowed) {
-  const YAML::Node& n = section.node();
-  if (!n || n.IsNull()) return;
-  if (!n.IsMap()) throw std::runtime_error(section.origin() + ": expected a map");
-  for (const auto& kv : n) {
-    const auto key = kv.first.as<std::string>();
-    if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-      std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      throw std::runtime_error(section.origin() + ": unknown key '" + key + "' (expected one of: " + list + ")");
-    }
-  }
+  std::vector<std::string> open;  // each allowed key with whatever it holds
+  for (const char* a : allowed) open.push_back(std::string(a) + ".*");
+  section.check_keys(open);
 }
 
 AvoidanceConfig avoidance_config_from(const util::Config& s, AvoidanceConfig c) {

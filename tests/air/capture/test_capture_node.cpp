@@ -112,6 +112,20 @@ channels: {left: L, stereo: ""}
   }
 }
 
+TEST(CaptureConfig, RefusesUnknownKeysAndValuesOutsideTheirRanges) {
+  const auto load = [](const std::string& text) { load_capture_config(util::Config::parse(text, "capture.yaml")); };
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"source: {fps: 1e308}\n", "capture.yaml: key 'source.fps' = 1e+308 is outside its valid range [0.01, 1000] (line 1)"},
+      {"sim:\n  speed: 1e308\n", "key 'sim.speed' = 1e+308 is outside its valid range [0.01, 20] (line 2)"},
+      {"output: {jpeg_quality: 0}\n", "'output.jpeg_quality' = 0 is outside its valid range [1, 100]"},
+      {"playback: {rate: -1}\n", "'playback.rate' = -1 is outside"},
+      {"source: {fsp: 20}\n", "unknown key 'source.fsp' (line 1)"},
+      {"playback: 1\n", "'playback' is a section of keys, not a value (line 1)"},
+      {"- source: {}\n", "expected a map of keys, not a list"},
+  };
+  test::expect_refusals(load, cases);
+}
+
 TEST(CaptureConfig, ShippedConfigsLoad) {
   for (const auto& entry : std::filesystem::directory_iterator(test::source_dir() / "config")) {
     const auto name = entry.path().filename().string();

@@ -4,7 +4,9 @@
 
 #include <Eigen/Geometry>
 #include <aerie/process_status_t.hpp>
+#include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "air/control/control_config.hpp"
 #include "air/control/control_loop.hpp"
@@ -12,6 +14,8 @@
 #include "air/control/heading_from_pose.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/util/time.hpp"
+#include "tests/common/bus/reliability_data.hpp"
+#include "tests/support/test_support.hpp"
 
 using namespace aerie;
 using namespace aerie::control;
@@ -136,14 +140,14 @@ TEST(ControlLoop, RefusesAnInvalidControllerAndKeepsTheOld) {
 }
 
 TEST(ControlConfig, ConfigFileAndErrors) {
-  const auto setup = node_setup(util::Config::load(std::string(AERIE_SOURCE_DIR) + "/config/control.yaml"));
+  const auto setup = node_setup(util::Config::load((test::source_dir() / "config" / "control.yaml").string()));
   EXPECT_EQ(setup.controller.id, "thesis-initial");
   EXPECT_EQ(setup.options.input, NodeOptions::Input::kVoPose);
   EXPECT_DOUBLE_EQ(setup.options.control.reference_deg, 90.0);
   CliOverrides cli;
   cli.input = "gt";
   cli.reference_deg = -90.0;
-  const auto gt = node_setup(util::Config::load(std::string(AERIE_SOURCE_DIR) + "/config/control.yaml"), cli);
+  const auto gt = node_setup(util::Config::load((test::source_dir() / "config" / "control.yaml").string()), cli);
   EXPECT_EQ(gt.options.input, NodeOptions::Input::kGtPose);
   EXPECT_EQ(gt.options.frame.up, Eigen::Vector3d(0, 0, 1));  // the shipped config keeps the per-input defaults
   EXPECT_EQ(gt.options.frame.forward, Eigen::Vector3d(0, 1, 0));
@@ -259,4 +263,157 @@ TEST(ControlNode, RefusesMalformedParametersAndTimesOutToHover) {
   EXPECT_EQ(counter("bad_pose"), 1);
   EXPECT_EQ(counter("VO_POSE.handler_errors"), 0);
   EXPECT_NE(last_status.message.find("vertical"), std::string::npos) << last_status.message;
+}
+
+TEST(ControlNode, OversizedControllersAreRefusedQuicklyAndCommandsGoOn) {
+  // FLC_PARAMS of the reliability reproducers: FLL with 1000^3 and 2048 x 2048 x 1024 sets
+  // (12 GB and an int overflow; 50 s without CTRL_CMD before). Refused by the set-count bounds
+  // before anything is allocated; the control loop keeps its controller and its rate.
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "control");
+  ControlNode node(bus, status, tuned(), NodeOptions{});
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  bus.publish("VO_POSE", vo_pose(1'000'000, 0.0));
+  drain(bus);
+  for (const char* file : {"flc_params_fll_1000cubed_12GB_alloc.bin", "flc_params_fll_2048x2048x1024_overflow.bin"}) {
+    const auto payload = test::read_bytes(test::reliability_data_dir() / file);
+    const auto t0 = std::chrono::steady_clock::now();
+    bus.raw().publish("FLC_PARAMS", payload.data(), static_cast<unsigned>(payload.size()));
+    drain(bus);
+    // Far below the control period's worth of seconds it took before (generous: shared CI machines).
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0) << file;
+    EXPECT_NE(status.message().find("more than 64 terms"), std::string::npos) << file << ": " << status.message();
+    node.publish_command(util::wall_utime());
+    drain(bus);
+  }
+  EXPECT_EQ(status.counter("params_refused"), 2);
+  ASSERT_EQ(cmds.size(), 2u);
+  for (const auto& c : cmds) {
+    EXPECT_EQ(c.mode, aerie::control_cmd_t::ACTIVE);
+    EXPECT_EQ(c.controller_id, "tuned");
+  }
+}
+
+TEST(ControlConfig, RefusesTimeoutsAndRatesOutsideTheirRanges) {
+  const auto load = [](const std::string& text) { node_setup(util::Config::parse(text, "control.yaml")); };
+  test::expect_refusals(load, {
+      {"stale_timeout_s: 1e308\n", "control.yaml: control: stale_timeout_s must be in (0, 60] s"},
+      {"limits:\n  max_yaw_rate_deg_s: 1e308\n", "max_yaw_rate_deg_s must be in (0, 720]"},
+      {"limits:\n  max_yaw_accel_deg_s2: .nan\n", "max_yaw_accel_deg_s2 must be in [0, 10000]"},
+      {"message_time:\n  max_jump_s: 1e308\n", "control.yaml:message_time: key 'max_jump_s' = 1e+308 is outside its valid range [1e-06, 3600] (line 2)"},
+      {"message_time:\n  resync_messages: 0\n", "message_time: key 'resync_messages' = 0 is outside its valid range [1, 1000]"},
+      {"message_time:\n  stale_timeout_s: 1\n", "staleness is the top-level 'stale_timeout_s'"},
+      {"message_time:\n  max_jumps: 1\n", "message_time: unknown key 'max_jumps' (line 2"},
+  });
+  EXPECT_EQ(test::refusal(load, "stale_timeout_s: 60\nlimits:\n  max_yaw_rate_deg_s: 720\n"), "");
+  const auto setup = node_setup(util::Config::parse("message_time:\n  max_jump_s: 2.5\n  resync_messages: 5\n", "c.yaml"));
+  EXPECT_EQ(setup.options.message_time.max_jump_us, 2'500'000);
+  EXPECT_EQ(setup.options.message_time.resync_messages, 5);
+  // The shipped config parses, with the documented defaults.
+  const auto shipped = node_setup(util::Config::load((test::source_dir() / "config" / "control.yaml").string()));
+  EXPECT_EQ(shipped.options.message_time.max_jump_us, 10'000'000);
+  EXPECT_EQ(shipped.options.message_time.resync_messages, 3);
+}
+
+namespace {
+
+// aerie-control in lock-step over memq://: the test owns the node clock; a pose at 30 Hz,
+// each followed by the command of that step.
+struct LockStep {
+  bus::Bus bus{"memq://"};
+  bus::StatusReporter status{bus, "control"};
+  int64_t now = 1'000'000'000;
+  ControlNode node;
+  std::vector<aerie::control_cmd_t> cmds;
+
+  explicit LockStep(NodeOptions opt = {}) : node(bus, status, tuned(), opt, [this] { return now; }) {
+    bus.subscribe<aerie::control_cmd_t>("CTRL_CMD",
+                                        [this](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  }
+  // One step of 1/30 s: an optional pose, then the command.
+  aerie::control_cmd_t step(std::optional<int64_t> pose_utime, double heading = 0.0) {
+    if (pose_utime) bus.publish("VO_POSE", vo_pose(*pose_utime, heading));
+    drain(bus);
+    now += 33'333;
+    node.publish_command(now);
+    drain(bus);
+    return cmds.back();
+  }
+};
+
+}  // namespace
+
+TEST(ControlNode, AFutureStampedPoseIsHeldAndControlKeepsFlying) {
+  // Issue 20: one VO_POSE with utime = INT64_MAX latched FALLBACK_HOVER for good, every real
+  // pose after it counted as pose_out_of_order.
+  LockStep s;
+  int64_t t = 5'000'000;
+  for (int k = 0; k < 5; ++k, t += 33'333) EXPECT_EQ(s.step(t).mode, aerie::control_cmd_t::ACTIVE);
+  const auto payload = test::read_bytes(test::reliability_data_dir() / "vo_pose_utime_INT64_MAX.bin");
+  s.bus.raw().publish("VO_POSE", payload.data(), static_cast<unsigned>(payload.size()));
+  EXPECT_EQ(s.step(std::nullopt).mode, aerie::control_cmd_t::ACTIVE);
+  EXPECT_EQ(s.status.counter("VO_POSE.time_jumps"), 1);
+  EXPECT_NE(s.status.message().find("VO_POSE utime 9223372036854775807 jumps forwards"), std::string::npos)
+      << s.status.message();
+  for (int k = 0; k < 60; ++k, t += 33'333) {  // two more seconds of real poses: each one flown
+    const auto c = s.step(t);
+    ASSERT_EQ(c.mode, aerie::control_cmd_t::ACTIVE) << k;
+    EXPECT_EQ(c.utime, t);
+  }
+  EXPECT_EQ(s.status.counter("poses"), 65);
+  EXPECT_EQ(s.status.counter("pose_out_of_order"), 0);
+  EXPECT_EQ(s.status.counter("VO_POSE.time_resyncs"), 0);
+  EXPECT_EQ(s.status.counter("commands_fallback"), 0);
+}
+
+TEST(ControlNode, ABackwardsJumpResynchronisesAfterNPoses) {
+  // VO restarts and its utime starts again from 0: the first 2 poses are held (the last
+  // command stays, not stale yet), the 3rd re-synchronises the loop, and it flies on.
+  LockStep s;
+  int64_t t = 500'000'000;
+  for (int k = 0; k < 10; ++k, t += 33'333) s.step(t, 10.0);
+  const int64_t last = t - 33'333;
+  t = 0;
+  for (int k = 0; k < 2; ++k, t += 33'333) {
+    const auto c = s.step(t, 10.0);
+    EXPECT_EQ(c.mode, aerie::control_cmd_t::ACTIVE);
+    EXPECT_EQ(c.utime, last);  // the held pose is not flown
+  }
+  EXPECT_EQ(s.status.counter("VO_POSE.time_jumps"), 2);
+  EXPECT_NE(s.status.message().find("backwards"), std::string::npos) << s.status.message();
+  for (int k = 0; k < 10; ++k, t += 33'333) {
+    const auto c = s.step(t, 10.0);
+    ASSERT_EQ(c.mode, aerie::control_cmd_t::ACTIVE) << k;
+    EXPECT_EQ(c.utime, t) << k;
+    EXPECT_TRUE(std::isfinite(c.yaw_rate_deg_s));
+  }
+  EXPECT_EQ(s.status.counter("VO_POSE.time_resyncs"), 1);
+  EXPECT_EQ(s.status.counter("pose_out_of_order"), 0);
+  EXPECT_NE(s.status.message().find("VO_POSE re-synchronised: time moved backwards"), std::string::npos)
+      << s.status.message();
+}
+
+TEST(ControlNode, A25SecondCameraOutageHoversReportsStaleAndRecovers) {
+  LockStep s;
+  int64_t t = 5'000'000;
+  for (int k = 0; k < 30; ++k, t += 33'333) EXPECT_EQ(s.step(t).mode, aerie::control_cmd_t::ACTIVE);
+  // 25 s without a pose: FALLBACK_HOVER after stale_timeout_s (0.5 s), reported stale once.
+  int hover = 0;
+  for (int k = 0; k < 750; ++k) hover += s.step(std::nullopt).mode == aerie::control_cmd_t::FALLBACK_HOVER;
+  EXPECT_GE(hover, 750 - 16);
+  EXPECT_EQ(s.status.counter("VO_POSE.stale"), 1);
+  EXPECT_EQ(s.status.counter("VO_POSE.outages"), 1);
+  EXPECT_EQ(s.status.message().rfind("VO_POSE stale: no message for 0.5", 0), 0u) << s.status.message();
+  // The camera comes back 25 s later: 2 poses held, then active again on every pose.
+  t += 25'000'000;
+  for (int k = 0; k < 2; ++k, t += 33'333) EXPECT_EQ(s.step(t).mode, aerie::control_cmd_t::FALLBACK_HOVER);
+  for (int k = 0; k < 30; ++k, t += 33'333) {
+    const auto c = s.step(t);
+    ASSERT_EQ(c.mode, aerie::control_cmd_t::ACTIVE) << k;
+    EXPECT_EQ(c.utime, t);
+  }
+  EXPECT_EQ(s.status.counter("VO_POSE.stale"), 0);
+  EXPECT_EQ(s.status.counter("VO_POSE.time_resyncs"), 1);
+  EXPECT_EQ(s.status.counter("pose_out_of_order"), 0);
 }

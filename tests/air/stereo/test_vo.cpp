@@ -19,7 +19,7 @@ namespace {
 
 stereo::VoParams params_from(const std::string& config) {
   stereo::VoParams p = stereo::vo_params_from_config(util::Config::load((test::source_dir() / config).string()),
-                                                     {"node"});
+                                                     stereo::kNodeSections);
   p.ba_synchronous = true;  // reproducible
   return p;
 }

@@ -10,6 +10,7 @@
 #include "air/stereo/node/vo_node.hpp"
 #include "common/image/image_message.hpp"
 #include "common/sim/simulation.hpp"
+#include "tests/support/test_support.hpp"
 
 using namespace aerie;
 
@@ -99,4 +100,109 @@ TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
   node.on_stereo(to_message(simulation.frame(0), K), 0);
   EXPECT_EQ(node.last()->status, stereo::VoStatus::Reset);
   EXPECT_EQ(status.counter("time_resets"), 1);
+}
+
+TEST(VoNode, OddImageSizesGiveDepthOnEveryDepthFrame) {
+  // 377 x 241 simulator frames failed on every pair ("disparity is 188x120, encoder expects
+  // 189x121"). 377/2 and 241/2 round down, 379/2 and 243/2 round up in cv::resize: both work.
+  for (const cv::Size size : {cv::Size(377, 241), cv::Size(379, 243)}) {
+    SCOPED_TRACE(std::to_string(size.width) + "x" + std::to_string(size.height));
+    bus::Bus bus("memq://");
+    bus::StatusReporter status(bus, "VO");
+    int depth_msgs = 0;
+    bus.subscribe<aerie::spherical_depth_t>("VO_DEPTH",
+                                            [&](const aerie::spherical_depth_t&, const bus::ReceiveInfo&) { ++depth_msgs; });
+    stereo::VoNodeConfig cfg;
+    cfg.vo.ba.enabled = false;
+    stereo::VoNode node(bus, status, cfg);
+    const sim::World world = sim::World::room(sim::WorldConfig{});
+    sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+    const auto K = simulation.intrinsics();
+    sim::StereoFrame f;
+    for (int i = 0; i < 6 && simulation.next(f); ++i) {
+      // Grown on the right and bottom: the intrinsics stay those of the rig.
+      const int dx = size.width - f.left.cols, dy = size.height - f.left.rows;
+      cv::copyMakeBorder(f.left, f.left, 0, dy, 0, dx, cv::BORDER_REPLICATE);
+      cv::copyMakeBorder(f.right, f.right, 0, dy, 0, dx, cv::BORDER_REPLICATE);
+      ASSERT_EQ(f.left.size(), size);
+      node.on_stereo(to_message(f, K), 0);
+      while (bus.handle(0) > 0) {
+      }
+    }
+    EXPECT_EQ(node.processed(), 6);
+    EXPECT_EQ(status.counter("errors"), 0);
+    EXPECT_EQ(depth_msgs, 3);
+    ASSERT_TRUE(node.last().has_value());
+    EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  }
+}
+
+TEST(VoNode, A25SecondCameraOutageIsReportedAndTheOdometryRecovers) {
+  // Issue 20: while the camera was down aerie-vo kept health OK. Lock-step: the node clock
+  // moves 50 ms per pair; 25 s of silence; then the camera comes back (25 s later in utime).
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "VO");
+  std::vector<aerie::pose_t> poses;
+  bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t& p, const bus::ReceiveInfo&) { poses.push_back(p); });
+  stereo::VoNodeConfig cfg;
+  cfg.vo.ba.enabled = false;
+  int64_t now = 1'000'000'000;
+  stereo::VoNode node(bus, status, cfg, [&] { return now; });
+  const sim::World world = sim::World::room(sim::WorldConfig{});
+  sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+  const auto K = simulation.intrinsics();
+  sim::StereoFrame f;
+  auto pair = [&](int64_t shift_us) {
+    simulation.next(f);
+    auto m = to_message(f, K);
+    m.utime += shift_us;
+    m.left.utime += shift_us;
+    m.right.utime += shift_us;
+    node.on_stereo(m, 0);
+    while (bus.handle(0) > 0) {
+    }
+    node.tick();
+    now += 50'000;
+    return m.utime;
+  };
+  for (int i = 0; i < 6; ++i) pair(0);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  EXPECT_EQ(status.counter("CAM_STEREO.stale"), 0);
+
+  for (int k = 0; k < 250; ++k, now += 100'000) node.tick();
+  EXPECT_EQ(status.counter("CAM_STEREO.stale"), 1);
+  EXPECT_EQ(status.counter("CAM_STEREO.outages"), 1);
+  EXPECT_EQ(status.message().rfind("CAM_STEREO stale: no message for 2.", 0), 0u) << status.message();
+
+  // Back 25 s later: 2 pairs held, the 3rd re-synchronises and restarts the odometry from the
+  // last pose (RESET), then OK poses with the new times; status OK again.
+  const size_t before = poses.size();
+  pair(25'000'000);
+  pair(25'000'000);
+  EXPECT_EQ(poses.size(), before);
+  EXPECT_EQ(status.counter("CAM_STEREO.time_jumps"), 2);
+  const int64_t resync_utime = pair(25'000'000);
+  ASSERT_EQ(poses.size(), before + 1);
+  EXPECT_EQ(poses.back().utime, resync_utime);
+  EXPECT_EQ(poses.back().status, aerie::pose_t::RESET);
+  EXPECT_EQ(status.counter("CAM_STEREO.time_resyncs"), 1);
+  EXPECT_EQ(status.counter("CAM_STEREO.stale"), 0);
+  for (int i = 0; i < 4; ++i) pair(25'000'000);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  EXPECT_EQ(poses.back().status, aerie::pose_t::OK);
+  EXPECT_EQ(status.message(), "OK");
+  EXPECT_EQ(status.counter("errors"), 0);
+}
+
+TEST(VoNode, MessageTimeKeysAreReadWithTheirRanges) {
+  const auto cfg = stereo::load_vo_node_config(util::Config::load((test::source_dir() / "config" / "vo.yaml").string()));
+  EXPECT_EQ(cfg.message_time.max_jump_us, 10'000'000);
+  EXPECT_EQ(cfg.message_time.resync_messages, 3);
+  EXPECT_EQ(cfg.message_time.stale_timeout_us, 2'000'000);
+  const auto load = [](const std::string& text) { stereo::load_vo_node_config(util::Config::parse(text, "vo.yaml")); };
+  test::expect_refusals(load, {
+      {"message_time:\n  stale_timeout_s: -1\n", "vo.yaml:message_time: key 'stale_timeout_s' = -1 is outside its valid range"},
+      {"message_time:\n  resync_messages: 1001\n", "key 'resync_messages' = 1001 is outside its valid range [1, 1000]"},
+      {"message_time:\n  jump: 1\n", "unknown key 'jump'"},
+  });
 }

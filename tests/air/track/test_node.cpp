@@ -7,7 +7,12 @@
 #include "common/image/image_message.hpp"
 #include "air/track/factory.hpp"
 #include "tests/air/track/synthetic.hpp"
+#include "tests/common/bus/reliability_data.hpp"
 #include "tests/support/test_support.hpp"
+
+#include <opencv2/imgproc.hpp>
+#include <limits>
+#include <tuple>
 
 using namespace aerie::track;
 using aerie::track::test::Motion;
@@ -231,4 +236,164 @@ TEST(NodeOptions, TheShippedConfigIsValidForEveryTracker) {
   const NodeOptions o = node_options(cfg);
   EXPECT_EQ(o.camera_channel, "CAM_LEFT");
   for (const auto& name : aerie_tracker_names()) EXPECT_NO_THROW(make_tracker(name, o.trackers.section(name))) << name;
+}
+
+TEST(NodeOptions, RefusesUnknownKeysSectionsAndBadTrackerParametersAtStartUp) {
+  const auto load = [](const std::string& text) { node_options(aerie::util::Config::parse(text, "track.yaml")); };
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"node:\n  trackr: ct\n", "track.yaml: unknown key 'node.trackr' (line 2"},
+      {"target: 5\n", "'target' is a section of keys, not a value (line 1)"},
+      {"- node: {}\n", "expected a map of keys, not a list (line 1)"},
+      {"node: {max_points: -1}\n", "'max_points' = -1 is outside its valid range [0, 100000]"},
+      {"target: {width_m: 1e308}\n", "'width_m' = 1e+308 is outside its valid range [0, 1000]"},
+      {"camera: {fx: 400, cx: 1, cy: 1, width: 100000}\n", "'width' = 100000 is outside"},
+      // Tracker sections are checked now, not at the first INIT.
+      {"trackers:\n  kcf: {}\n", "trackers.kcf: unknown tracker (line 2)"},
+      {"trackers:\n  dcf: {template_area: 1e9}\n", "'template_area' = 1e+09 is outside its valid range [64, 1.04858e+06]"},
+      {"trackers:\n  ct: {features: 10000000}\n", "'features' = 10000000 is outside its valid range [1, 10000]"},
+      {"trackers:\n  mil: {featurs: 10}\n", "unknown parameter 'featurs' for tracker 'mil'"},
+  };
+  aerie::test::expect_refusals(load, cases);
+  for (const char* shipped : {"track.yaml", "track_landing.yaml"})
+    EXPECT_NO_THROW(node_options(aerie::util::Config::load((aerie::test::source_dir() / "config" / shipped).string())))
+        << shipped;
+}
+
+TEST_F(NodeTest, OversizedOverridesAreRefusedAndTrackingGoesOn) {
+  // TRACK_CMD overrides template_area=1e9 and features=1e7 stalled tracking for tens of seconds.
+  TrackNode node(bus_, NodeOptions{});
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  send_init(scene_.box(motion(0)), "amcmr-ct");
+  bus_.publish("CAM_LEFT", frame(1));
+  settle(node);
+  for (const auto& [tracker, name, value] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"dcf", "template_area", "1e9"}, {"amcmr-ct", "features", "10000000"}}) {
+    aerie::track_cmd_t c{};
+    c.command = aerie::track_cmd_t::SET_TRACKER;
+    c.tracker = tracker;
+    c.nparams = 1;
+    c.param_names = {name};
+    c.param_values = {value};
+    bus_.publish("TRACK_CMD", c);
+  }
+  bus_.publish("CAM_LEFT", frame(2));
+  settle(node);
+  EXPECT_EQ(node.counter("command_errors"), 2);
+  aerie::bus::StatusReporter status(bus_, "track");
+  node.report(status);
+  EXPECT_NE(status.message().find("'features' = 10000000 is outside its valid range"), std::string::npos)
+      << status.message();
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  EXPECT_EQ(tracks_.back().tracker, "amcmr-ct");
+}
+
+TEST_F(NodeTest, AFrameOfAnotherSizeEndsTheTrackWithAReason) {
+  TrackNode node(bus_, NodeOptions{});
+  aerie::bus::StatusReporter status(bus_, "track");
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  send_init(scene_.box(motion(0)));
+  bus_.publish("CAM_LEFT", frame(1));
+  settle(node);
+  ASSERT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  cv::Mat small;
+  cv::resize(scene_.render(motion(2)), small, {120, 90});
+  bus_.publish("CAM_LEFT", aerie::image::to_message(small, 2'000'000, 2));
+  settle(node);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::IDLE);  // the pilot sees the track end at once
+  EXPECT_EQ(tracks_.back().utime, 2'000'000);
+  EXPECT_EQ(node.counter("frame_size_changes"), 1);
+  node.report(status);
+  EXPECT_NE(status.message().find("frame size changed from 240x180 to 120x90; track of amcmr-ct ended"),
+            std::string::npos) << status.message();
+  // A new INIT on the new size tracks again.
+  send_init({40, 40, 20, 16});
+  bus_.publish("CAM_LEFT", aerie::image::to_message(small, 2'100'000, 3));
+  settle(node);
+  bus_.publish("CAM_LEFT", aerie::image::to_message(small, 2'200'000, 4));
+  settle(node);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+}
+
+TEST_F(NodeTest, APngBombIsRefusedBeforeDecoding) {
+  // 249 KB of PNG declaring 16000 x 16000 (256 MB decoded): refused by its declared size.
+  TrackNode node(bus_, NodeOptions{});
+  aerie::bus::StatusReporter status(bus_, "track");
+  const auto payload = aerie::test::read_bytes(aerie::test::reliability_data_dir() / "cam_left_png_bomb_16000x16000.bin");
+  bus_.raw().publish("CAM_LEFT", payload.data(), static_cast<unsigned>(payload.size()));
+  settle(node);
+  EXPECT_EQ(node.counter("decode_errors"), 1);
+  node.report(status);
+  EXPECT_NE(status.message().find("16000x16000 is larger than the limit of 16777216 pixels"), std::string::npos)
+      << status.message();
+  // With a configured camera, the cap is its size: a larger frame is refused, the camera's size tracks.
+  NodeOptions opt;
+  opt.camera = aerie::camera::CameraModel{};
+  opt.camera->width = 240, opt.camera->height = 180;
+  TrackNode capped(bus_, opt);
+  cv::Mat big;
+  cv::resize(scene_.render(motion(0)), big, {480, 360});
+  bus_.publish("CAM_LEFT", aerie::image::to_message(big, 1'000'000, 0, aerie::image::Encoding::Png));
+  settle(capped);
+  EXPECT_EQ(capped.counter("decode_errors"), 1);
+  bus_.publish("CAM_LEFT", aerie::image::to_message(scene_.render(motion(1)), 1'100'000, 1, aerie::image::Encoding::Png));
+  settle(capped);
+  EXPECT_EQ(capped.counter("decode_errors"), 1);
+}
+
+// Issue 20: while the camera was down aerie-track kept health OK. Lock-step: the node clock
+// moves 33 ms a frame; 25 s without frames; the camera comes back 25 s later in utime.
+TEST_F(NodeTest, ACameraOutageIsReportedAndTrackingGoesOnAfterIt) {
+  int64_t now = 1'000'000'000;
+  TrackNode node(bus_, NodeOptions{}, [&] { return now; });
+  aerie::bus::StatusReporter status(bus_, "track");
+  auto send = [&](int i, int64_t shift_us) {
+    aerie::image_t m = frame(i);
+    m.utime += shift_us;
+    bus_.publish("CAM_LEFT", m);
+    settle(node);
+    now += 33'333;
+    node.report(status);
+    return m.utime;
+  };
+  send(0, 0);
+  send_init(scene_.box(motion(0)), "amcmr-ct");
+  settle(node);
+  for (int i = 1; i <= 5; ++i) send(i, 0);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  EXPECT_EQ(status.counter("CAM_LEFT.stale"), 0);
+  EXPECT_EQ(status.message(), "tracking with amcmr-ct");
+
+  for (int k = 0; k < 250; ++k, now += 100'000) node.report(status);
+  EXPECT_EQ(status.counter("CAM_LEFT.stale"), 1);
+  EXPECT_EQ(status.counter("CAM_LEFT.outages"), 1);
+  EXPECT_EQ(status.message().rfind("CAM_LEFT stale: no message for 2.", 0), 0u) << status.message();
+
+  // Back 25 s later: 2 frames held (nothing published for them), then tracked with their utime.
+  const size_t before = tracks_.size();
+  send(6, 25'000'000);
+  send(7, 25'000'000);
+  EXPECT_EQ(tracks_.size(), before);
+  EXPECT_EQ(status.counter("CAM_LEFT.time_jumps"), 2);
+  for (int i = 8; i <= 12; ++i) {
+    const int64_t utime = send(i, 25'000'000);
+    ASSERT_FALSE(tracks_.empty());
+    EXPECT_EQ(tracks_.back().utime, utime);
+  }
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  EXPECT_NEAR(tracks_.back().x, motion(12).centre.x, 4);
+  EXPECT_EQ(status.counter("CAM_LEFT.time_resyncs"), 1);
+  EXPECT_EQ(status.counter("CAM_LEFT.stale"), 0);
+  EXPECT_EQ(status.message(), "tracking with amcmr-ct");
+
+  // A frame stamped INT64_MAX is held: no TRACK or TARGET_POSE carries that time.
+  aerie::image_t bogus = frame(13);
+  bogus.utime = std::numeric_limits<int64_t>::max();
+  bus_.publish("CAM_LEFT", bogus);
+  settle(node);
+  send(14, 25'000'000);
+  for (const auto& t : tracks_) EXPECT_NE(t.utime, std::numeric_limits<int64_t>::max());
+  EXPECT_EQ(status.counter("CAM_LEFT.time_jumps"), 3);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
 }

@@ -392,3 +392,83 @@ TEST(ErrorSignals, DerivativeAndIntegralOverMessageTime) {
   EXPECT_DOUBLE_EQ(wrap_deg(540.0), -180.0);
   EXPECT_DOUBLE_EQ(wrap_deg(-190.0), 170.0);
 }
+
+namespace {
+// A controller of thesis_initial() shape with n0 x n1 x n2 input sets (evenly spaced) and one rule.
+FlcSpec with_sets(int n0, int n1, int n2) {
+  FlcSpec s = thesis_initial();
+  const int n[3] = {n0, n1, n2};
+  for (int i = 0; i < 3; ++i) {
+    Variable& v = s.inputs[i];
+    v.min = -1;
+    v.max = n[i];
+    v.sets.clear();
+    v.positions.clear();
+    for (int k = 0; k < n[i]; ++k) {
+      v.sets.push_back("s" + std::to_string(k));
+      v.positions.push_back(k);
+    }
+  }
+  s.rules = {Rule{{0, 0, 0}, 0, 1.0}};
+  return s;
+}
+
+std::string refusal(const FlcSpec& s) {
+  try {
+    Flc f(s);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Validation, RuleTableSizeIsCheckedIn64BitsBeforeAllocating) {
+  // 2048 x 2048 x 1024 = 2^32 overflowed the int product (a crash); 1626^3 wrapped to 3975080
+  // cells (an aliased table). Both are refused by their true size, before any allocation.
+  EXPECT_EQ(rule_table_cells({5, 5, 5}), 125);
+  std::string e = refusal(with_sets(2048, 2048, 1024));
+  EXPECT_NE(e.find("rule table of 2048 x 2048 x 1024 input sets = 4294967296 cells is larger than 262144"),
+            std::string::npos) << e;
+  e = refusal(with_sets(1626, 1626, 1626));
+  EXPECT_NE(e.find("1626 x 1626 x 1626 input sets = 4298942376 cells"), std::string::npos) << e;
+  try {
+    rule_table_cells({INT32_MAX, INT32_MAX, INT32_MAX});  // overflows int64 too
+    FAIL();
+  } catch (const std::invalid_argument& e2) {
+    EXPECT_NE(std::string(e2.what()).find("2147483647 x 2147483647 x 2147483647 input sets is larger"), std::string::npos)
+        << e2.what();
+  }
+  // One variable past kMaxSets, however small the table.
+  FlcSpec wide = with_sets(2, 2, 2);
+  wide.output.sets.clear();
+  wide.output.positions.clear();
+  for (int k = 0; k <= kMaxSets; ++k) {
+    wide.output.sets.push_back("o" + std::to_string(k));
+    wide.output.positions.push_back(k * 1e-3);
+  }
+  wide.output.min = -1, wide.output.max = 1;
+  EXPECT_NE(refusal(wide).find("has 65 sets, more than 64"), std::string::npos) << refusal(wide);
+  EXPECT_EQ(refusal(with_sets(64, 64, 64)), "");  // the largest table is accepted
+}
+
+TEST(FllFormat, RefusesTooManyTermsAndTooLongTexts) {
+  // The reproducer's shape: 2048 terms in one input. Refused at the 65th term line.
+  std::string fll = "Engine: big\nInputVariable: error\n  enabled: true\n  range: -2048 2048\n  lock-range: true\n";
+  for (int k = 0; k < 2048; ++k)
+    fll += "  term: s" + std::to_string(k) + " Triangle " + std::to_string(k - 1) + " " + std::to_string(k) + " " +
+           std::to_string(k + 1) + "\n";
+  try {
+    parse_fll(fll, "big.fll");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("big.fll:70: 'error' has more than 64 terms"), std::string::npos) << e.what();
+  }
+  try {
+    parse_fll(std::string(kMaxFllBytes + 1, '#'), "huge.fll");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.fll: FLL text of 1048577 bytes, more than 1048576"), std::string::npos)
+        << e.what();
+  }
+}

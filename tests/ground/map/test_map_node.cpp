@@ -87,3 +87,24 @@ TEST(MapNode, BadArgumentsFailWithACode) {
   EXPECT_NE(wait_exit(spawn({AERIE_MAP_EXE, "--load", (dir / "missing.bt").string()}), 20.0), 0);
   EXPECT_EQ(wait_exit(spawn({AERIE_MAP_EXE, "--help"}), 20.0), 0);
 }
+
+TEST(MapNode, LoadRefusesAnOtWithAGarbageBody) {
+  // The header of a real map, then random bytes: was loaded as 39,879 nodes of nonsense.
+  const auto dir = aerie::test::scratch_dir("garbage");
+  aerie::map::OccupancyMap map;
+  for (int i = 0; i < 50; ++i) map.insert_frame({{2.05f, 0.05f * i, 0.05f}}, {0.05f, 0.05f, 0.05f});
+  const auto good = (dir / "good.ot").string();
+  map.save(good);
+  std::ifstream in(good, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  uint32_t x = 12345;
+  for (size_t i = text.find("data\n") + 5; i < text.size(); ++i) {
+    x = x * 1664525u + 1013904223u;
+    text[i] = static_cast<char>(x >> 24);
+  }
+  const auto garbage = (dir / "garbage.ot").string();
+  std::ofstream(garbage, std::ios::binary) << text;
+  EXPECT_THROW(aerie::map::read_octree_file(garbage), std::runtime_error);
+  EXPECT_EQ(wait_exit(spawn({AERIE_MAP_EXE, "--lcm-url", "memq://", "--save", "", "--load", garbage}), 20.0), 1);
+  EXPECT_NO_THROW(aerie::map::read_octree_file(good));
+}

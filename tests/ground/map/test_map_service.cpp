@@ -6,14 +6,18 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <aerie/map_response_t.hpp>
 #include <aerie/octomap_t.hpp>
+#include <aerie/process_status_t.hpp>
 #pragma GCC diagnostic pop
 
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <random>
 #include <sstream>
 
 #include "common/spherical/spherical_message.hpp"
 #include "ground/map/map_service.hpp"
+#include "tests/common/bus/reliability_data.hpp"
 #include "tests/ground/map/room_fixture.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -28,6 +32,7 @@ const cv::Size kSize(376, 240);
 struct Harness {
   aerie::bus::Bus bus{"memq://"};
   aerie::bus::StatusReporter status{bus, "aerie-map"};
+  int64_t now_us = 0;  // the node's clock (lock-step: the test moves it)
   m::MapService service;
   std::vector<aerie::map_response_t> responses;
   std::vector<aerie::octomap_t> maps;
@@ -35,8 +40,9 @@ struct Harness {
   aerie::spherical::SphericalEncoder encoder{kCam, kSize};
   int64_t seq = 0;
 
-  explicit Harness(m::MapServiceConfig cfg = {}) : service(bus, status, cfg) {
-    bus.subscribe<aerie::map_response_t>("REPLY", [this](const auto& r, const ReceiveInfo&) { responses.push_back(r); });
+  explicit Harness(m::MapServiceConfig cfg = {}) : service(bus, status, cfg, [this] { return now_us; }) {
+    bus.subscribe<aerie::map_response_t>("MAP_RESPONSE_TEST",
+                                         [this](const auto& r, const ReceiveInfo&) { responses.push_back(r); });
     bus.subscribe<aerie::octomap_t>("MAP_OCTOMAP", [this](const auto& r, const ReceiveInfo&) { maps.push_back(r); });
   }
   void spin() {
@@ -68,7 +74,7 @@ struct Harness {
     }
     q.max_range = max_range;
     q.depth = depth;
-    q.reply_channel = "REPLY";
+    q.reply_channel = "MAP_RESPONSE_TEST";
     responses.clear();
     bus.publish("MAP_QUERY", q);
     spin();
@@ -160,10 +166,10 @@ TEST(MapService, MatchesPosesByUtimeAndCountsBadInputs) {
   EXPECT_EQ(h.counter("depth_without_pose"), 1);
   EXPECT_EQ(h.counter("frames_mapped"), 2);
 
-  // A pose far in the future is rejected; mapping goes on.
+  // A pose far in the future is held (the message-time policy); mapping goes on.
   h.bus.publish("VO_POSE", h.pose_msg(1'700'000 + 3600'000'000LL, T));
   h.spin();
-  EXPECT_EQ(h.counter("future_utime"), 1);
+  EXPECT_EQ(h.counter("VO.time_jumps"), 1);
   h.bus.publish("VO_DEPTH", h.depth_msg(1'750'000, T, true));
   h.spin();
   EXPECT_EQ(h.counter("frames_mapped"), 3);
@@ -196,10 +202,80 @@ TEST(MapService, MatchesPosesByUtimeAndCountsBadInputs) {
   EXPECT_EQ(h.counter("frames_mapped"), 4);
 }
 
+TEST(MapService, RecoversFromA25SecondOutageAndARestartAndReportsTheOutage) {
+  // Issue 20: after any VO outage longer than 10 s (and after one bogus future utime) the map
+  // dropped every VO_POSE/VO_DEPTH for good as "N s ahead of the newest message". Lock-step:
+  // the node clock moves with the frames, 20 Hz.
+  m::MapServiceConfig cfg;
+  cfg.publish_period_s = 0.5;
+  Harness h(cfg);
+  const auto v = views();
+  int frame = 0;
+  auto fly = [&](int64_t utime0, int frames) {  // VO_POSE + VO_DEPTH (without its own pose)
+    for (int k = 0; k < frames; ++k, ++frame) {
+      const auto& T = v[static_cast<size_t>(frame) % v.size()];
+      const int64_t utime = utime0 + k * 50'000;
+      h.bus.publish("VO_DEPTH", h.depth_msg(utime, T, false));
+      h.bus.publish("VO_POSE", h.pose_msg(utime, T));
+      h.spin();
+      h.service.tick();
+      h.now_us += 50'000;
+    }
+  };
+  aerie::process_status_t published{};
+  h.bus.subscribe<aerie::process_status_t>(h.status.channel(),
+                                           [&](const auto& m, const ReceiveInfo&) { published = m; });
+  auto health = [&] {
+    h.status.publish_now();
+    h.spin();
+    return published.health;
+  };
+  h.now_us = 1'000'000'000;
+  fly(1'000'000, 10);
+  EXPECT_EQ(h.counter("frames_mapped"), 10);
+  EXPECT_EQ(h.counter("VO.stale"), 0);
+
+  // The camera stops for 25 s: the map reports VO stale after message_time.stale_timeout_s (2 s).
+  for (int k = 0; k < 250; ++k, h.now_us += 100'000) h.service.tick();
+  EXPECT_EQ(h.counter("VO.stale"), 1);
+  EXPECT_EQ(h.counter("VO.outages"), 1);
+  EXPECT_EQ(h.status.message().rfind("VO stale: no message for 2.", 0), 0u) << h.status.message();
+  EXPECT_EQ(health(), aerie::process_status_t::WARN);
+  EXPECT_EQ(published.message, h.status.message());
+
+  // It restarts 25 s later: the first 2 messages (one frame's depth and pose) are held, the
+  // 3rd re-synchronises, and every later frame is mapped; status OK again.
+  const size_t maps_before = h.maps.size();
+  fly(26'500'000, 20);
+  EXPECT_EQ(h.counter("VO.time_jumps"), 2);
+  EXPECT_EQ(h.counter("VO.time_resyncs"), 1);
+  EXPECT_EQ(h.counter("frames_mapped"), 10 + 19);  // the first frame back (its depth and pose) was held
+  EXPECT_EQ(h.counter("VO.stale"), 0);
+  EXPECT_EQ(health(), aerie::process_status_t::OK) << published.message;
+  EXPECT_GT(h.maps.size(), maps_before);  // publication goes on in the new message time
+
+  // One bogus future utime is held and does not disturb the next frames.
+  h.bus.publish("VO_POSE", h.pose_msg(std::numeric_limits<int64_t>::max(), v[0]));
+  h.spin();
+  fly(27'500'000, 5);
+  EXPECT_EQ(h.counter("VO.time_jumps"), 3);
+  EXPECT_EQ(h.counter("frames_mapped"), 29 + 5);
+
+  // VO restarts from utime 0 (backwards): re-synchronised after 3 messages; the poses of the
+  // old time base are dropped, so a depth at a reused utime is never matched with an old pose.
+  fly(1'000'000, 10);  // the utimes of the first flight again
+  EXPECT_EQ(h.counter("VO.time_resyncs"), 2);
+  EXPECT_EQ(h.counter("frames_mapped"), 34 + 9);
+  EXPECT_EQ(h.counter("VO.stale"), 0);
+  EXPECT_EQ(health(), aerie::process_status_t::OK) << published.message;
+}
+
 TEST(MapService, PublishesFullAndChangedRegionAndObeysCommands) {
+  const auto dir = aerie::test::scratch_dir("cmd");
   m::MapServiceConfig cfg;
   cfg.publish_period_s = 0.1;
   cfg.full_every = 3;
+  cfg.files_directory = dir.string();
   Harness h(cfg);
   int64_t t = 0;
   for (const auto& T : views()) {
@@ -227,11 +303,10 @@ TEST(MapService, PublishesFullAndChangedRegionAndObeysCommands) {
   EXPECT_LT(h.maps[2].bbox_max[1] - h.maps[2].bbox_min[1], h.maps[3].bbox_max[1] - h.maps[3].bbox_min[1] + 1e-9);
 
   // Commands: save, clear, load, publish.
-  const auto dir = aerie::test::scratch_dir("cmd");
   const std::string path = (dir / "saved.ot").string();
   aerie::map_cmd_t cmd{};
   cmd.command = aerie::map_cmd_t::SAVE;
-  cmd.path = path;
+  cmd.path = "saved.ot";  // a name in files.directory
   h.bus.publish("MAP_CMD", cmd);
   h.spin();
   ASSERT_TRUE(std::filesystem::exists(path));
@@ -252,7 +327,7 @@ TEST(MapService, PublishesFullAndChangedRegionAndObeysCommands) {
   ASSERT_EQ(h.maps.size(), 1u);
   EXPECT_TRUE(h.maps[0].full);
   cmd.command = aerie::map_cmd_t::LOAD;
-  cmd.path = (dir / "nope.bt").string();
+  cmd.path = "nope.bt";
   h.bus.publish("MAP_CMD", cmd);
   h.spin();
   EXPECT_EQ(h.counter("command_errors"), 1);
@@ -268,6 +343,9 @@ TEST(MapService, ConfigFileKeysAreRead) {
   EXPECT_DOUBLE_EQ(cfg.occupancy.stereo.focal_px, 163.0);
   EXPECT_EQ(cfg.full_every, 10);
   EXPECT_EQ(cfg.response_channel, "MAP_RESPONSE");
+  EXPECT_EQ(cfg.message_time.max_jump_us, 10'000'000);
+  EXPECT_EQ(cfg.message_time.resync_messages, 3);
+  EXPECT_EQ(cfg.message_time.stale_timeout_us, 2'000'000);
   try {
     m::MapServiceConfig::from_config(aerie::util::Config::parse("sensor_model:\n  hit: 1.5\n", "bad.yaml"));
     FAIL();
@@ -275,4 +353,182 @@ TEST(MapService, ConfigFileKeysAreRead) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("sensor_model/hit"), std::string::npos);
   }
+}
+
+namespace {
+
+// A harness whose map holds the room seen from its west half; MAP_CMD files go to `dir`.
+void map_room(Harness& h) {
+  int64_t t = 1'000'000;
+  for (const auto& T : views()) {
+    h.bus.publish("VO_DEPTH", h.depth_msg(t, T, true));
+    t += 50'000;
+  }
+  h.spin();
+}
+
+void command(Harness& h, int8_t kind, const std::string& path) {
+  aerie::map_cmd_t cmd{};
+  cmd.command = kind;
+  cmd.path = path;
+  h.bus.publish("MAP_CMD", cmd);
+  h.spin();
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+const Eigen::Vector3d kInside(-1.5, 0.0, 1.2);
+
+}  // namespace
+
+TEST(MapService, SaveAndLoadAreConfinedToTheFilesDirectory) {
+  const auto root = aerie::test::scratch_dir("confined");
+  m::MapServiceConfig cfg;
+  cfg.files_directory = (root / "maps").string();  // created by the first SAVE
+  Harness h(cfg);
+  map_room(h);
+  std::ofstream(root / "outside.ot") << "precious";
+  // Paths that leave the directory, or are not plain map names: refused, nothing written.
+  const std::vector<std::string> bad{(root / "abs.ot").string(), "../outside.ot", "../escape.ot", "sub/x.ot",
+                                     ".hidden.ot", "map.txt", "", std::string(65, 'a') + ".ot"};
+  for (const auto& p : bad) command(h, aerie::map_cmd_t::SAVE, p);
+  EXPECT_EQ(h.counter("command_errors"), static_cast<int64_t>(bad.size()));
+  EXPECT_NE(h.status.message().find("is not a plain map file name"), std::string::npos) << h.status.message();
+  EXPECT_FALSE(std::filesystem::exists(root / "abs.ot"));
+  EXPECT_FALSE(std::filesystem::exists(root / "escape.ot"));
+  EXPECT_EQ(slurp(root / "outside.ot"), "precious");
+  for (const auto& p : bad) command(h, aerie::map_cmd_t::LOAD, p);
+  EXPECT_EQ(h.counter("command_errors"), 2 * static_cast<int64_t>(bad.size()));
+
+  // SAVE never overwrites: the second save of a name is a new version.
+  const auto maps = root / "maps";
+  command(h, aerie::map_cmd_t::SAVE, "room.ot");
+  ASSERT_TRUE(std::filesystem::exists(maps / "room.ot"));
+  const std::string first = slurp(maps / "room.ot");
+  std::ofstream(maps / "room-1.ot") << "an older version";
+  command(h, aerie::map_cmd_t::SAVE, "room.ot");
+  EXPECT_EQ(slurp(maps / "room.ot"), first);
+  EXPECT_EQ(slurp(maps / "room-1.ot"), "an older version");
+  ASSERT_TRUE(std::filesystem::exists(maps / "room-2.ot"));
+  EXPECT_NE(h.status.message().find("room-2.ot"), std::string::npos) << h.status.message();
+
+  // A symbolic link in the directory is neither followed by SAVE nor read by LOAD.
+  std::filesystem::create_symlink(root / "outside.ot", maps / "link.ot");
+  command(h, aerie::map_cmd_t::SAVE, "link.ot");
+  EXPECT_EQ(slurp(root / "outside.ot"), "precious");
+  EXPECT_TRUE(std::filesystem::exists(maps / "link-1.ot"));
+  const int64_t errors = h.counter("command_errors");
+  command(h, aerie::map_cmd_t::LOAD, "link.ot");
+  EXPECT_EQ(h.counter("command_errors"), errors + 1);
+  EXPECT_NE(h.status.message().find("is a symbolic link"), std::string::npos) << h.status.message();
+  command(h, aerie::map_cmd_t::LOAD, "room-2.ot");
+  EXPECT_EQ(h.counter("command_errors"), errors + 1);
+  EXPECT_EQ(h.query(aerie::map_query_t::OCCUPANCY, kInside).occupancy, aerie::map_response_t::FREE);
+
+  // Without files.directory, SAVE and LOAD over LCM are off.
+  Harness off;
+  command(off, aerie::map_cmd_t::SAVE, "room.ot");
+  EXPECT_EQ(off.counter("command_errors"), 1);
+  EXPECT_NE(off.status.message().find("files.directory is not set"), std::string::npos) << off.status.message();
+}
+
+TEST(MapService, LoadChecksTheFileAndKeepsTheOldMap) {
+  const auto dir = aerie::test::scratch_dir("load");
+  m::MapServiceConfig cfg;
+  cfg.files_directory = dir.string();
+  Harness h(cfg);
+  map_room(h);
+  // Files of the reproducers: resolutions 1e300 and 1e-300, a .ot with a garbage body, trailing bytes.
+  std::ostringstream bt, ot;
+  h.service.map().tree().writeBinaryConst(bt);
+  h.service.map().tree().write(ot);
+  auto with = [](std::string s, const std::string& from, const std::string& to) {
+    const auto at = s.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? s : s.replace(at, from.size(), to);
+  };
+  std::ofstream(dir / "res_1e300.bt") << with(bt.str(), "res 0.1\n", "res 1e+300\n");
+  std::ofstream(dir / "res_1e-300.bt") << with(bt.str(), "res 0.1\n", "res 1e-300\n");
+  std::string garbage = ot.str();
+  std::mt19937 rng(7);
+  for (size_t i = garbage.find("data\n") + 5; i < garbage.size(); ++i) garbage[i] = static_cast<char>(rng());
+  std::ofstream(dir / "garbage.ot") << garbage;
+  std::ofstream(dir / "trailing.bt") << bt.str() << "trailing bytes";
+  const size_t nodes = h.service.map().tree().size();
+  const std::vector<std::pair<std::string, std::string>> bad{
+      {"res_1e300.bt", "resolution 1000000"}, {"res_1e-300.bt", "resolution 0.000000 m, outside [0.010000"},
+      {"garbage.ot", "log-odds"}, {"trailing.bt", "followed by bytes"}};
+  int64_t errors = 0;
+  for (const auto& [file, why] : bad) {
+    command(h, aerie::map_cmd_t::LOAD, file);
+    EXPECT_EQ(h.counter("command_errors"), ++errors) << file;
+    EXPECT_NE(h.status.message().find(why), std::string::npos) << file << ": " << h.status.message();
+    // The live map is the old one.
+    EXPECT_DOUBLE_EQ(h.service.map().params().resolution, 0.1) << file;
+    EXPECT_EQ(h.service.map().tree().size(), nodes) << file;
+    EXPECT_EQ(h.query(aerie::map_query_t::OCCUPANCY, kInside).occupancy, aerie::map_response_t::FREE) << file;
+  }
+  // The nearest-obstacle query of the reproducer (it crashed DynamicEDT3D after res_1e300.bt):
+  // its reply channel FZ_RESPONSE is not a map reply channel, so it is refused; the same query
+  // on MAP_RESPONSE_TEST is answered from the old map.
+  const auto payload = aerie::test::read_bytes(aerie::test::reliability_data_dir() / "map_query_nearest_obstacle_origin.bin");
+  h.bus.raw().publish("MAP_QUERY", payload.data(), static_cast<unsigned>(payload.size()));
+  h.spin();
+  EXPECT_EQ(h.counter("query_reply_refused"), 1);
+  const auto origin = h.query(aerie::map_query_t::NEAREST_OBSTACLE, Eigen::Vector3d::Zero());
+  EXPECT_TRUE(origin.error.empty()) << origin.error;
+  const auto near = h.query(aerie::map_query_t::NEAREST_OBSTACLE, kInside);
+  EXPECT_GT(near.distance, 0.0);
+  EXPECT_TRUE(near.error.empty()) << near.error;
+}
+
+TEST(MapService, RepliesOnlyOnTheDocumentedReplyChannels) {
+  EXPECT_TRUE(m::valid_reply_channel("MAP_RESPONSE", "MAP_RESPONSE"));
+  EXPECT_TRUE(m::valid_reply_channel("MAP_RESPONSE_PILOT_2", "MAP_RESPONSE"));
+  EXPECT_TRUE(m::valid_reply_channel("MAP_RESPONSE_" + std::string(32, 'x'), "MAP_RESPONSE"));
+  for (const std::string& c : std::vector<std::string>{"CTRL_CMD", "MAP_RESPONSE_", "MAP_RESPONSEX", "MAP_RESPONSE_a/b",
+                                                      "map_response", "MAP_RESPONSE_" + std::string(33, 'x')})
+    EXPECT_FALSE(m::valid_reply_channel(c, "MAP_RESPONSE")) << c;
+  Harness h;
+  int ctrl = 0;
+  h.bus.subscribe<aerie::map_response_t>("CTRL_CMD", [&](const auto&, const ReceiveInfo&) { ++ctrl; });
+  aerie::map_query_t q{};
+  q.kind = aerie::map_query_t::OCCUPANCY;
+  q.reply_channel = "CTRL_CMD";
+  h.bus.publish("MAP_QUERY", q);
+  h.spin();
+  EXPECT_EQ(ctrl, 0);
+  EXPECT_EQ(h.counter("query_reply_refused"), 1);
+  EXPECT_NE(h.status.message().find("reply channel 'CTRL_CMD' is not MAP_RESPONSE"), std::string::npos)
+      << h.status.message();
+  h.query(aerie::map_query_t::OCCUPANCY, kInside);  // MAP_RESPONSE_TEST: answered
+}
+
+TEST(MapService, ConfigRefusesUnknownKeysAndValuesOutsideTheirRanges) {
+  // Duplicate keys are refused by the parser itself, the rest by the config's reader.
+  const auto load = [](const std::string& text) {
+    m::MapServiceConfig::from_config(aerie::util::Config::parse(text, "map.yaml"));
+  };
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"resolution: 1e308\n", "key 'resolution' = 1e+308 is outside its valid range [0.01, 10] (line 1)"},
+      {"resolution: 1e-300\n", "key 'resolution' = 1e-300 is outside"},
+      {"sensor_model:\n  max_range: 1e308\n", "key 'sensor_model.max_range' = 1e+308 is outside its valid range [0.01, 1000] (line 2)"},
+      {"distance_map:\n  max_cells: 0\n", "'distance_map.max_cells' = 0 is outside"},
+      {"distance_map:\n  max_cells: -5\n", "'distance_map.max_cells' = -5 is outside"},
+      {"publish:\n  period_s: .nan\n", "'publish.period_s' = nan is outside its valid range [0, 3600]"},
+      {"publish:\n  period_s: -1\n", "'publish.period_s' = -1 is outside"},
+      {"matching:\n  pose_buffer: -1\n", "'matching.pose_buffer' = -1 is outside its valid range [1, 100000]"},
+      {"message_time:\n  max_jump_s: 1e308\n", "message_time: key 'max_jump_s' = 1e+308 is outside its valid range"},
+      {"message_time:\n  resync_messages: -1\n", "message_time: key 'resync_messages' = -1 is outside"},
+      {"matching:\n  max_future_us: 10000000\n", "unknown key 'matching.max_future_us'"},
+      {"resolutoin: 0.1\n", "unknown key 'resolutoin' (line 1"},
+      {"sensor_model: 5\n", "'sensor_model' is a section of keys, not a value (line 1)"},
+      {"- resolution: 0.1\n", "expected a map of keys, not a list"},
+      {"resolution: 0.1\nresolution: 0.2\n", "duplicate key 'resolution' (line 1 and line 2)"},
+  };
+  aerie::test::expect_refusals(load, cases);
+  EXPECT_EQ(aerie::test::refusal(load, "publish:\n  period_s: 0\n"), "");  // 0 = never publish
 }

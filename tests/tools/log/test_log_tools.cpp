@@ -248,5 +248,76 @@ TEST(LogCut, TimeRangeFromTheStart) {
   EXPECT_THROW(cut(log, 0, 1, log), std::invalid_argument);
 }
 
+TEST(LogCut, RefusesToOverwriteAnExistingOutputWithoutForce) {
+  const auto dir = test::scratch_dir("log");
+  const auto log = make_log(dir).string();
+  const auto out = (dir / "cut.lcm").string();
+  std::ofstream(out) << "a recording";
+  try {
+    cut(log, 0.2, 0.4, out);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.lcm exists; pass --force to overwrite it"), std::string::npos) << e.what();
+  }
+  std::ifstream in(out);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), "a recording");
+  EXPECT_EQ(cut(log, 0.2, 0.4, out, false, true).events_written, 12);  // --force
+}
+
+TEST(LogExport, RefusesANonEmptyOutputFolderWithoutForce) {
+  const auto dir = test::scratch_dir("log");
+  const auto log = make_log(dir).string();
+  fs::create_directories(dir / "empty");
+  const int64_t poses = export_channel(log, "GT_POSE", (dir / "empty").string()).exported;  // an empty folder is fine
+  EXPECT_GT(poses, 0);
+  const auto tum = dir / "empty" / "GT_POSE.tum";
+  std::ofstream(tum) << "edited by hand\n";
+  try {
+    export_channel(log, "GT_POSE", (dir / "empty").string());
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("exists and is not an empty folder; pass --force"), std::string::npos) << e.what();
+  }
+  std::ifstream in(tum);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), "edited by hand\n");
+  EXPECT_EQ(export_channel(log, "GT_POSE", (dir / "empty").string(), false, true).exported, poses);  // --force
+  EXPECT_EQ(static_cast<int64_t>(capture::read_tum(tum.string()).size()), poses);
+}
+
+TEST(LogInfo, AnEmptyLogIsReportedAsEmpty) {
+  const auto dir = test::scratch_dir("log");
+  std::ofstream(dir / "empty.lcm").close();
+  const auto s = summarize((dir / "empty.lcm").string());
+  EXPECT_EQ(s.events, 0);
+  std::ostringstream out;
+  print_summary(s, out);
+  EXPECT_NE(out.str().find("empty:    the log holds no events"), std::string::npos) << out.str();
+  EXPECT_EQ(out.str().find("damage:   none"), std::string::npos) << out.str();
+}
+
+TEST(LogInfo, AHostilePayloadIsCountedAsCorrupt) {
+  // The log of the reproducer aerie-log_info_segv_track_cmd_strlen_INT_MIN.lcm: a TRACK_CMD
+  // whose string length is INT_MIN, between two good events.
+  const auto dir = test::scratch_dir("log");
+  const auto payload = [] {
+    std::ifstream in(std::string(AERIE_SOURCE_DIR) + "/tests/data/reliability/track_cmd_strlen_INT_MIN.bin", std::ios::binary);
+    return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }();
+  ASSERT_FALSE(payload.empty());
+  const auto path = (dir / "hostile.lcm").string();
+  {
+    logio::Writer w(path);
+    const uint8_t raw[3] = {1, 2, 3};
+    w.write(1000, "RAW", raw, sizeof raw);
+    w.write(2000, "TRACK_CMD", payload.data(), payload.size());
+    w.write(3000, "RAW", raw, sizeof raw);
+    w.close();
+  }
+  const auto s = summarize(path);
+  EXPECT_EQ(s.events, 3);
+  EXPECT_EQ(channel(s, "TRACK_CMD").undecodable, 1);
+  EXPECT_TRUE(s.damage.empty());
+}
+
 }  // namespace
 }  // namespace aerie::logtools
