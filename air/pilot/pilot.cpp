@@ -38,9 +38,11 @@ void PilotConfig::validate() const {
        "survey, descent and abort speeds must be > 0, the hold climb >= 0");
   need(approach_height_m > touchdown_height_m && touchdown_height_m > 0,
        "approach.height_m must exceed descent.touchdown_height_m > 0");
-  need(approach_tolerance_m > 0 && yaw_tolerance_deg > 0 && height_tolerance_m > 0 && descent_gate_m > 0,
-       "tolerances and descent.gate_m must be > 0");
-  need(settle_frames >= 1 && loss_frames >= 1, "settle_frames and loss_frames must be >= 1");
+  need(approach_tolerance_m > 0 && yaw_tolerance_deg > 0 && height_tolerance_m > 0 && descent_gate_m > 0 &&
+           handover_tolerance_m > 0,
+       "tolerances, descent.gate_m and descent.handover_tolerance_m must be > 0");
+  need(settle_frames >= 1 && loss_frames >= 1 && handover_frames >= 1,
+       "settle_frames, loss_frames and descent.handover_frames must be >= 1");
   need(stale_timeout_s > 0 && control_period_s > 0 && abort_climb_s >= 0 && hold_climb_max_s >= 0,
        "stale_timeout_s and control_period_s must be > 0");
   for (const auto& leg : survey_legs) need(leg.allFinite(), "survey legs must be finite");
@@ -235,13 +237,32 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
         lost(State::Descend);
         break;
       }
-      if (height < cfg_.touchdown_height_m) {
-        enter(State::Touchdown, utime, "below the touchdown height");
-        c.mode = Command::Mode::Land;
+      if (!target_->fitted) {
+        // A box-only pose is too coarse this low: a box cut by the image border, chased,
+        // leads the vehicle off the pad. Hover, and climb slowly (a wider view) until the
+        // pad's geometry is fitted again.
+        settled_run_ = 0;
+        if (height < cfg_.approach_height_m) c.velocity.z() = cfg_.hold_climb_m_s;
         break;
       }
-      const double gate = std::clamp(1.0 - p.head<2>().norm() / cfg_.descent_gate_m, 0.0, 1.0);
-      c = steer(utime, t, p, yaw_err, -cfg_.descent_speed_m_s * gate);
+      const double off = p.head<2>().norm();
+      if (height < cfg_.touchdown_height_m) {
+        // The autopilot's LAND below is blind and keeps the point where it begins: hand over
+        // only when centred and aligned, else hold this height and keep centring on vision.
+        settled_run_ = off < cfg_.handover_tolerance_m && std::abs(yaw_err) < cfg_.yaw_tolerance_deg ? settled_run_ + 1 : 0;
+        if (settled_run_ >= cfg_.handover_frames) {
+          enter(State::Touchdown, utime, "centred below the touchdown height");
+          c.mode = Command::Mode::Land;
+        } else {
+          c = steer(utime, t, p, yaw_err, 0.0);
+        }
+        break;
+      }
+      // Slower with the horizontal error (the gate) and near the handover height (1/s on the
+      // height left, crossing it at 5 cm/s), so that the pad stays in view.
+      const double gate = std::clamp(1.0 - off / cfg_.descent_gate_m, 0.0, 1.0);
+      const double vz = std::min(cfg_.descent_speed_m_s * gate, height - cfg_.touchdown_height_m + 0.05);
+      c = steer(utime, t, p, yaw_err, -vz);
       break;
     }
     case State::Touchdown:

@@ -49,7 +49,9 @@ struct PilotConfig {
   int settle_frames = 10;               // ... for this many frames in a row -> DESCEND
   double descent_speed_m_s = 0.35;
   double descent_gate_m = 0.3;       // the descent slows linearly to 0 at this horizontal error
-  double touchdown_height_m = 1.0;   // below this height vision hands over to the autopilot LAND
+  double touchdown_height_m = 1.4;   // below this height vision hands over to the autopilot LAND ...
+  double handover_tolerance_m = 0.05;  // ... once centred within this ...
+  int handover_frames = 3;             // ... for this many frames in a row (the LAND below is blind)
   double touchdown_time_s = 3.0;     // TOUCHDOWN -> LANDED after this long
   double stale_timeout_s = 0.5;      // no tracker result for this long -> HOLD
   int loss_frames = 3;               // tracker lost this many frames in a row -> HOLD
@@ -77,6 +79,7 @@ struct TargetObservation {
   int64_t utime = 0;
   Eigen::Vector3d position_cam = Eigen::Vector3d::Zero();  // camera optical frame, m
   double yaw_cam = 0;  // the pad's axis from image x towards image y, rad
+  bool fitted = true;  // the target's geometry fitted in the image; false: from the tracker's box only
 };
 
 struct PilotStatus {

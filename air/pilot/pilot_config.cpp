@@ -52,7 +52,8 @@ PilotConfig load_pilot_config(const util::Config& cfg) {
       "height_tolerance_m", &P::height_tolerance_m)("settle_frames", &P::settle_frames)
       .finish();
   util::SectionReader<P>(cfg.section("descent"), p)("speed_m_s", &P::descent_speed_m_s)("gate_m", &P::descent_gate_m)(
-      "touchdown_height_m", &P::touchdown_height_m)("touchdown_time_s", &P::touchdown_time_s)
+      "touchdown_height_m", &P::touchdown_height_m)("handover_tolerance_m", &P::handover_tolerance_m)(
+      "handover_frames", &P::handover_frames)("touchdown_time_s", &P::touchdown_time_s)
       .finish();
   util::SectionReader<P>(cfg.section("hold"), p)("stale_timeout_s", &P::stale_timeout_s)(
       "loss_frames", &P::loss_frames)("timeout_s", &P::hold_timeout_s)("climb_m_s", &P::hold_climb_m_s)(

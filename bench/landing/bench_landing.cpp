@@ -89,8 +89,8 @@ double percentile(std::vector<double> v, double p) {
 std::string summary(const Setup& s, const std::vector<landing::RunResult>& runs) {
   int ok = 0;
   std::vector<double> err, time, losses;
-  double rm[4] = {0, 0, 0, 0};
-  size_t n_desc = 0;
+  double rm[4] = {0, 0, 0, 0}, fit[4] = {0, 0, 0, 0};
+  size_t n_desc = 0, n_fit = 0;
   double wall = 0, sim_s = 0;
   for (const auto& r : runs) {
     ok += r.score.success;
@@ -100,24 +100,29 @@ std::string summary(const Setup& s, const std::vector<landing::RunResult>& runs)
     }
     losses.push_back(r.losses);
     for (const auto& d : r.descent) {
-      rm[0] += d.ex * d.ex;
-      rm[1] += d.ey * d.ey;
-      rm[2] += d.ez * d.ez;
-      rm[3] += d.eyaw_deg * d.eyaw_deg;
+      const double e2[4] = {d.ex * d.ex, d.ey * d.ey, d.ez * d.ez, d.eyaw_deg * d.eyaw_deg};
+      for (int a = 0; a < 4; ++a) {
+        rm[a] += e2[a];
+        if (d.fitted) fit[a] += e2[a];
+      }
+      n_fit += d.fitted;
     }
     n_desc += r.descent.size();
     wall += r.wall_s;
     sim_s += r.sim_s;
   }
   for (double& v : rm) v = n_desc ? std::sqrt(v / static_cast<double>(n_desc)) : std::nan("");
-  char line[512];
+  for (double& v : fit) v = n_fit ? std::sqrt(v / static_cast<double>(n_fit)) : std::nan("");
+  char line[640];
   std::snprintf(line, sizeof line,
                 "%-11s %-5s %-5s wind %.0f vib %-3s: %d/%zu landed in bounds (%.1f %%), touchdown error mean %.3f m p95 "
-                "%.3f m, time %.1f s, losses %.2f/run, TARGET_POSE RMSE x %.1f y %.1f z %.1f cm yaw %.2f deg, %.2f s "
-                "wall per simulated s",
+                "%.3f m, time %.1f s, losses %.2f/run, TARGET_POSE RMSE x %.1f y %.1f z %.1f cm yaw %.2f deg (fitted "
+                "poses: x %.1f y %.1f z %.1f cm yaw %.2f deg, box-only %.1f %%), %.2f s wall per simulated s",
                 s.tracker.c_str(), s.controller.c_str(), s.world.c_str(), s.wind, s.vibration ? "on" : "off", ok,
                 runs.size(), 100.0 * ok / static_cast<double>(runs.size()), mean(err), percentile(err, 0.95),
-                mean(time), mean(losses), 100 * rm[0], 100 * rm[1], 100 * rm[2], rm[3], wall / sim_s);
+                mean(time), mean(losses), 100 * rm[0], 100 * rm[1], 100 * rm[2], rm[3], 100 * fit[0], 100 * fit[1],
+                100 * fit[2], fit[3], n_desc ? 100.0 * static_cast<double>(n_desc - n_fit) / static_cast<double>(n_desc) : 0.0,
+                wall / sim_s);
   return line;
 }
 
@@ -170,8 +175,8 @@ int main(int argc, char** argv) {
   std::ofstream csv(out_dir + "/landings.csv"), desc(out_dir + "/descent.csv");
   csv << "seed,tracker,world,wind_m_s,vibration,success,touchdown_error_m,yaw_error_deg,time_s,collision,losses,"
          "reacquisitions,controller,landed,timed_out,final_state,lockstep_timeouts,pose_rmse_x_m,pose_rmse_y_m,"
-         "pose_rmse_z_m,pose_rmse_yaw_deg,pad_refined,pad_not_found,tracker_reseeded,pad_misses,sim_s,wall_s\n";
-  desc << "seed,tracker,world,wind_m_s,vibration,controller,t_s,height_m,err_x_m,err_y_m,err_z_m,err_yaw_deg\n";
+         "pose_rmse_z_m,pose_rmse_yaw_deg,fit_rmse_x_m,fit_rmse_y_m,fit_rmse_z_m,fit_rmse_yaw_deg,box_poses,pad_refined,pad_not_found,tracker_reseeded,pad_misses,sim_s,wall_s\n";
+  desc << "seed,tracker,world,wind_m_s,vibration,controller,t_s,height_m,err_x_m,err_y_m,err_z_m,err_yaw_deg,fitted\n";
   int failures = 0;
   for (const auto& s : setups) {
     const landing::RunConfig config = setup_config(s, files);
@@ -203,11 +208,13 @@ int main(int argc, char** argv) {
           << r.outcome.collided << ',' << r.losses << ',' << r.reacquisitions << ',' << s.controller << ','
           << r.outcome.landed << ',' << r.outcome.timed_out
           << ',' << r.final_state << ',' << r.lockstep_timeouts << ',' << r.rmse(0) << ',' << r.rmse(1) << ','
-          << r.rmse(2) << ',' << r.rmse(3) << ',' << r.pad_refined << ',' << r.pad_not_found << ','
+          << r.rmse(2) << ',' << r.rmse(3) << ',' << r.rmse(0, true) << ',' << r.rmse(1, true) << ',' << r.rmse(2, true)
+          << ',' << r.rmse(3, true) << ',' << r.box_poses() << ',' << r.pad_refined << ',' << r.pad_not_found << ','
           << r.tracker_reseeded << ',' << r.pad_misses << ',' << r.sim_s << ',' << r.wall_s << '\n';
       for (const auto& d : r.descent)
         desc << run_seed << ',' << s.tracker << ',' << s.world << ',' << s.wind << ',' << vib << ',' << s.controller << ','
-             << d.t << ',' << d.height << ',' << d.ex << ',' << d.ey << ',' << d.ez << ',' << d.eyaw_deg << '\n';
+             << d.t << ',' << d.height << ',' << d.ex << ',' << d.ey << ',' << d.ez << ',' << d.eyaw_deg << ',' << d.fitted
+             << '\n';
     }
     csv.flush();
     desc.flush();

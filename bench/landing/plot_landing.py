@@ -31,8 +31,8 @@ def table(landings, descent):
     for r in descent:
         desc[conf(r)].append(r)
     out = ["| tracker | controller | world | wind (m/s) | vibration | runs | success | touchdown error mean / p95 (cm) "
-           "| time (s) | losses / run | TARGET_POSE RMSE x / y / z (cm), yaw (deg) |",
-           "|---|---|---|---|---|---|---|---|---|---|---|"]
+           "| time (s) | losses / run | TARGET_POSE RMSE x / y / z (cm), yaw (deg) | fitted poses only (box-only share) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for k in sorted(runs):
         rs = runs[k]
         ok = sum(int(r["success"]) for r in rs)
@@ -40,12 +40,16 @@ def table(landings, descent):
         err = sorted(100 * float(r["touchdown_error_m"]) for r in landed)
         p95 = err[min(len(err) - 1, max(0, -(-95 * len(err) // 100) - 1))] if err else float("nan")
         mean = lambda v: sum(v) / len(v) if v else float("nan")
-        rmse = lambda col: mean([float(r[col]) ** 2 for r in desc[k]]) ** 0.5
+        fitted = [r for r in desc[k] if r.get("fitted", "1") == "1"]
+        rmse = lambda col, rs=desc[k]: mean([float(r[col]) ** 2 for r in rs]) ** 0.5
+        box = 100 * (1 - len(fitted) / len(desc[k])) if desc[k] else float("nan")
         out.append(f"| {k[0]} | {k[1]} | {k[2]} | {k[3]:g} | {k[4]} | {len(rs)} | {ok}/{len(rs)} ({100 * ok / len(rs):.0f} %) "
                    f"| {mean(err):.1f} / {p95:.1f} | {mean([float(r['time_s']) for r in landed]):.1f} "
                    f"| {mean([int(r['losses']) for r in rs]):.2f} "
                    f"| {100 * rmse('err_x_m'):.2f} / {100 * rmse('err_y_m'):.2f} / {100 * rmse('err_z_m'):.2f}, "
-                   f"{rmse('err_yaw_deg'):.2f} |")
+                   f"{rmse('err_yaw_deg'):.2f} "
+                   f"| {100 * rmse('err_x_m', fitted):.2f} / {100 * rmse('err_y_m', fitted):.2f} / "
+                   f"{100 * rmse('err_z_m', fitted):.2f}, {rmse('err_yaw_deg', fitted):.2f} ({box:.1f} %) |")
     return "\n".join(out) + "\n"
 
 

@@ -3,6 +3,7 @@
 #include <aerie/pilot_state_t.hpp>
 #include <aerie/target_pose_t.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -13,14 +14,20 @@
 
 namespace aerie::landing {
 
-double RunResult::rmse(int axis) const {
-  if (descent.empty()) return std::nan("");
+double RunResult::rmse(int axis, bool fitted_only) const {
   double s = 0;
+  size_t n = 0;
   for (const auto& d : descent) {
+    if (fitted_only && !d.fitted) continue;
     const double e = axis == 0 ? d.ex : axis == 1 ? d.ey : axis == 2 ? d.ez : d.eyaw_deg;
     s += e * e;
+    ++n;
   }
-  return std::sqrt(s / static_cast<double>(descent.size()));
+  return n ? std::sqrt(s / static_cast<double>(n)) : std::nan("");
+}
+
+int64_t RunResult::box_poses() const {
+  return std::count_if(descent.begin(), descent.end(), [](const DescentSample& d) { return !d.fitted; });
 }
 
 RunResult fly(const RunConfig& config) {
@@ -48,7 +55,8 @@ RunResult fly(const RunConfig& config) {
     const sim::TargetTruth& g = it->second;
     r.descent.push_back({m.utime * 1e-6, g.position.z(), m.position[0] - g.position.x(), m.position[1] - g.position.y(),
                          m.position[2] - g.position.z(),
-                         std::remainder(m.yaw - g.yaw, std::numbers::pi) * 180 / std::numbers::pi});
+                         std::remainder(m.yaw - g.yaw, std::numbers::pi) * 180 / std::numbers::pi,
+                         m.source == aerie::target_pose_t::SOURCE_FIT});
   });
 
   int64_t end_frame = -1;

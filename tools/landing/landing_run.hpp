@@ -26,9 +26,11 @@ struct RunConfig {
   std::function<void(const std::string&, const uint8_t*, size_t)> on_message;
 };
 
-// TARGET_POSE against the truth of its frame, during the pilot's DESCEND.
+// TARGET_POSE against the truth of its frame, during the pilot's DESCEND; fitted: the pad's
+// corners fitted (SOURCE_FIT, what the pilot descends on), else the tracker's box only.
 struct DescentSample {
   double t = 0, height = 0, ex = 0, ey = 0, ez = 0, eyaw_deg = 0;
+  bool fitted = true;
 };
 
 struct RunResult {
@@ -41,7 +43,9 @@ struct RunResult {
   std::string pad_misses;          // "reason:count ..." of the frames the pad was not found
   double sim_s = 0, wall_s = 0;
   std::vector<DescentSample> descent;
-  double rmse(int axis) const;     // 0..2: x, y, z (m); 3: yaw (deg); NaN without samples
+  // 0..2: x, y, z (m); 3: yaw (deg); over every DESCEND sample or the fitted ones; NaN without samples
+  double rmse(int axis, bool fitted_only = false) const;
+  int64_t box_poses() const;       // DESCEND samples from the tracker's box only
 };
 
 RunResult fly(const RunConfig& config);

@@ -25,7 +25,10 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
   };
   bus_.subscribe<aerie::target_pose_t>(opt_.target_channel, [this, guarded](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
     guarded(opt_.target_channel, [&] {
-      pilot_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.yaw});
+      if (m.source != aerie::target_pose_t::SOURCE_BOX && m.source != aerie::target_pose_t::SOURCE_FIT)
+        throw std::invalid_argument("unknown target pose source " + std::to_string(m.source));
+      pilot_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.yaw,
+                        m.source == aerie::target_pose_t::SOURCE_FIT});
       count("targets");
     });
   });

@@ -530,6 +530,7 @@ void TrackNode::publish(const Frame& frame, const TrackState* s, double ms, cons
       for (int i = 0; i < 3; ++i) tp.position[i] = p.position[i];
       tp.yaw = p.yaw;
       tp.confidence = m.confidence;
+      tp.source = pad ? aerie::target_pose_t::SOURCE_FIT : aerie::target_pose_t::SOURCE_BOX;
       bus_.publish(opt_.pose_channel, tp);
       count("poses_published");
     } catch (const std::exception& e) {

@@ -31,10 +31,10 @@ struct Flight {
   int64_t utime = 0;
   explicit Flight(PilotConfig c) : pilot(std::move(c)) {}
   Command frame(TrackStatus status = TrackStatus::Idle, double height = 0, Eigen::Vector2d offset = {0, 0},
-                double yaw_error_deg = 0) {
+                double yaw_error_deg = 0, bool fitted = true) {
     utime += kFrame;
     if (status == TrackStatus::Tracking || status == TrackStatus::Redetected)
-      pilot.on_target({utime, {offset.x(), offset.y(), height}, (yaw_error_deg - 90) * kDeg});
+      pilot.on_target({utime, {offset.x(), offset.y(), height}, (yaw_error_deg - 90) * kDeg, fitted});
     return pilot.on_track(utime, status);
   }
   // Frames until the state changes (at most n); returns the frames flown.
@@ -71,17 +71,54 @@ TEST(Pilot, FliesTheMissionTakeoffSurveyApproachDescendTouchdownLanded) {
   }
   EXPECT_EQ(n, f.pilot.config().settle_frames);
   EXPECT_EQ(f.pilot.state(), State::Descend);
-  const Command down = f.frame(TrackStatus::Tracking, 1.5);
+  const double h = f.pilot.config().touchdown_height_m;
+  const Command down = f.frame(TrackStatus::Tracking, h + 0.5);
   EXPECT_NEAR(down.velocity.z(), -f.pilot.config().descent_speed_m_s, 1e-9);
   // Off-centre by the gate: the descent stops.
-  const Command gated = f.frame(TrackStatus::Tracking, 1.5, {f.pilot.config().descent_gate_m, 0});
+  const Command gated = f.frame(TrackStatus::Tracking, h + 0.5, {f.pilot.config().descent_gate_m, 0});
   EXPECT_NEAR(gated.velocity.z(), 0.0, 1e-9);
-  const Command land = f.frame(TrackStatus::Tracking, f.pilot.config().touchdown_height_m - 0.01);
+  // Near the handover height the descent slows down: it crosses it at 5 cm/s.
+  EXPECT_NEAR(f.frame(TrackStatus::Tracking, h + 0.05).velocity.z(), -0.10, 1e-9);
+  // Below it but off-centre: hold the height and keep centring, no LAND.
+  const Command centring = f.frame(TrackStatus::Tracking, h - 0.01, {0, -0.2});  // ahead
+  EXPECT_EQ(f.pilot.state(), State::Descend);
+  EXPECT_EQ(centring.mode, Command::Mode::Velocity);
+  EXPECT_NEAR(centring.velocity.z(), 0.0, 1e-9);
+  EXPECT_GT(centring.velocity.x(), 0.0);
+  // Centred: LAND after the handover frames.
+  for (int i = 1; i < f.pilot.config().handover_frames; ++i) {
+    f.frame(TrackStatus::Tracking, h - 0.01);
+    EXPECT_EQ(f.pilot.state(), State::Descend);
+  }
+  const Command land = f.frame(TrackStatus::Tracking, h - 0.01);
   EXPECT_EQ(f.pilot.state(), State::Touchdown);
   EXPECT_EQ(land.mode, Command::Mode::Land);
   f.until_change(1000);
   EXPECT_EQ(f.pilot.state(), State::Landed);
   EXPECT_EQ(f.frame().mode, Command::Mode::Land);
+}
+
+TEST(Pilot, DescendsOnlyOnPosesFittedToThePadAndClimbsOnABoxOnlyPose) {
+  PilotConfig c = config();
+  c.survey_legs.clear();
+  Flight f(c);
+  f.frame();
+  f.until_change(1000);  // the take-off, then ACQUIRE
+  f.frame(TrackStatus::Tracking, c.approach_height_m);
+  while (f.pilot.state() == State::Approach) f.frame(TrackStatus::Tracking, c.approach_height_m);
+  ASSERT_EQ(f.pilot.state(), State::Descend);
+  // A box-only pose (the pad cut by the border), even centred and low: no descent, no
+  // LAND, a slow climb and no chase of the box.
+  for (int i = 0; i < 2 * c.handover_frames; ++i) {
+    const Command up = f.frame(TrackStatus::Tracking, c.touchdown_height_m - 0.1, {0.3, 0}, 0, false);
+    EXPECT_EQ(f.pilot.state(), State::Descend);
+    EXPECT_EQ(up.mode, Command::Mode::Velocity);
+    EXPECT_NEAR(up.velocity.z(), c.hold_climb_m_s, 1e-9);
+    EXPECT_EQ(up.velocity.head<2>(), Eigen::Vector2d::Zero());
+  }
+  // Fitted again: it centres and hands over.
+  for (int i = 0; i < c.handover_frames; ++i) f.frame(TrackStatus::Tracking, c.touchdown_height_m - 0.1);
+  EXPECT_EQ(f.pilot.state(), State::Touchdown);
 }
 
 TEST(Pilot, ATargetSeenDuringTheTakeoffIsApproachedAfterTheMinimumTakeoffTime) {
