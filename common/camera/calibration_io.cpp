@@ -1,9 +1,10 @@
 #include "common/camera/calibration_io.hpp"
 
+#include "common/util/files.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
-#include <fstream>
 #include <opencv2/core/persistence.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -17,13 +18,7 @@ namespace {
   throw std::runtime_error(file + ": " + msg);
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) fail(path, "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string read_text(const std::string& path) { return util::read_regular_file(path, "calibration file"); }
 
 std::vector<double> yaml_doubles(const YAML::Node& root, const std::string& key, const std::string& file,
                                  size_t expected = 0) {
@@ -96,8 +91,7 @@ StereoCalibration read_euroc_stereo(const std::string& mav0_dir) {
 }
 
 StereoCalibration read_kitti_stereo(const std::string& calib_txt, int width, int height) {
-  std::ifstream in(calib_txt);
-  if (!in) fail(calib_txt, "cannot open file");
+  std::istringstream in(read_text(calib_txt));
   std::vector<std::vector<double>> rows;
   std::string line;
   int lineno = 0;

@@ -1,5 +1,7 @@
 #include "common/flc/flc_io.hpp"
 
+#include "common/util/files.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -20,13 +22,7 @@ std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot open");
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
+std::string read_file(const std::string& path) { return util::read_regular_file(path, "controller file"); }
 
 void write_file(const std::string& path, const std::string& text) {
   std::ofstream f(path);

@@ -1,5 +1,7 @@
 #include "common/util/config.hpp"
 
+#include "common/util/files.hpp"
+
 #include <algorithm>
 #include <filesystem>
 #include <functional>
@@ -41,11 +43,7 @@ void refuse_duplicates(const YAML::Node& n, const std::string& origin, const std
 }  // namespace
 
 Config Config::load(const std::string& path) {
-  std::error_code ec;
-  const auto st = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(st)) throw std::runtime_error(path + ": config file not found");
-  // Opening a FIFO (or a device) blocks or never ends: only a regular file (or a symlink to one) is a config.
-  if (!std::filesystem::is_regular_file(st)) throw std::runtime_error(path + ": a config must be a regular file");
+  require_regular_file(path, "config file");
   Config c;
   c.origin_ = path;
   try {

@@ -4,6 +4,8 @@
 
 #include <fstream>
 
+#include "common/camera/calibration_io.hpp"
+#include "common/flc/flc_io.hpp"
 #include "common/util/config.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -45,8 +47,15 @@ TEST(Config, RefusesAFileThatIsNotRegular) {
   const auto fifo = dir / "config.yaml";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const std::string e = error_of([&] { Config::load(fifo.string()); });
-  EXPECT_NE(e.find("config.yaml: a config must be a regular file"), std::string::npos) << e;
+  EXPECT_NE(e.find("config.yaml: a config file must be a regular file"), std::string::npos) << e;
   EXPECT_NE(error_of([&] { Config::load(dir.string()); }).find("regular file"), std::string::npos);
+  // The same for the other files a user names: a controller and a calibration.
+  EXPECT_NE(error_of([&] { aerie::flc::load_controller(fifo.string()); }).find("a controller file must be a regular file"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { aerie::camera::read_kitti_stereo(fifo.string(), 376, 240); })
+                .find("a calibration file must be a regular file"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { aerie::camera::read_euroc_camera(fifo.string()); }).find("regular file"), std::string::npos);
 }
 
 TEST(Config, RefusesDuplicateKeysNamingBothLines) {
