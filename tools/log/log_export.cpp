@@ -5,6 +5,7 @@
 #include <aerie/image_t.hpp>
 #include <aerie/pose_t.hpp>
 #include <aerie/stereo_image_t.hpp>
+#include <aerie/track_t.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -166,6 +167,46 @@ class BoxExporter final : public Exporter {
   std::ofstream out_;
 };
 
+// Tracker output, one row per TRACK message (one per frame tracked). The box is the tracker's
+// axis-aligned box of the unrotated target (TrackState::box()): top-left corner x, y and width,
+// height in pixels, in the image coordinates the trackers use (0-based, as OpenCV; no +1 of the
+// MATLAB-made OTB files), as aerie-bench-track reads and writes OTB boxes. theta stays in the
+// message. An IDLE frame (no target) has no box: NaN, which the OTB readers take as "no target".
+class TrackExporter final : public Exporter {
+ public:
+  TrackExporter(const fs::path& csv, const fs::path& otb, ExportResult& r) : csv_(open_out(csv)), otb_(open_out(otb)) {
+    r.outputs = {csv.string(), otb.string()};
+    csv_ << "t,seq,x,y,w,h,status,confidence\n";
+  }
+  bool consume(const logio::Event& ev) override {
+    aerie::track_t m;
+    if (!decode(ev, m)) return false;
+    char box[160], line[320];
+    if (m.status == aerie::track_t::IDLE) {
+      std::snprintf(box, sizeof box, "NaN,NaN,NaN,NaN");
+    } else {
+      std::snprintf(box, sizeof box, "%.3f,%.3f,%.3f,%.3f", m.x - m.width / 2, m.y - m.height / 2, m.width, m.height);
+    }
+    std::snprintf(line, sizeof line, "%s,%lld,%s,%s,%.3f\n", utime_to_seconds(m.utime).c_str(),
+                  static_cast<long long>(m.seq), box, status_name(m.status).c_str(), m.confidence);
+    csv_ << line;
+    otb_ << box << "\n";
+    return true;
+  }
+
+ private:
+  static std::string status_name(int8_t s) {
+    switch (s) {
+      case aerie::track_t::IDLE: return "IDLE";
+      case aerie::track_t::TRACKING: return "TRACKING";
+      case aerie::track_t::LOST: return "LOST";
+      case aerie::track_t::REDETECTED: return "REDETECTED";
+      default: return std::to_string(s);
+    }
+  }
+  std::ofstream csv_, otb_;
+};
+
 std::unique_ptr<Exporter> make_exporter(const std::string& type, const std::string& channel, const fs::path& dir,
                                         ExportResult& r) {
   if (type == "aerie.image_t") return std::make_unique<ImageExporter>(dir, r);
@@ -173,6 +214,8 @@ std::unique_ptr<Exporter> make_exporter(const std::string& type, const std::stri
   if (type == "aerie.gt_pose_t") return std::make_unique<TumExporter<aerie::gt_pose_t>>(dir / (channel + ".tum"), r);
   if (type == "aerie.pose_t") return std::make_unique<TumExporter<aerie::pose_t>>(dir / (channel + ".tum"), r);
   if (type == "aerie.gt_box_t") return std::make_unique<BoxExporter>(dir / (channel + ".csv"), r);
+  if (type == "aerie.track_t")
+    return std::make_unique<TrackExporter>(dir / (channel + ".csv"), dir / (channel + ".txt"), r);
   return nullptr;
 }
 
@@ -208,7 +251,7 @@ ExportResult export_channel(const std::string& log_path, const std::string& chan
       exporter = make_exporter(r.type, channel, out_dir, r);
       if (!exporter)
         throw std::runtime_error(log_path + ": channel " + channel + " carries " + r.type +
-                                 ", which cannot be exported (images, stereo pairs, poses and boxes can)");
+                                 ", which cannot be exported (images, stereo pairs, poses, boxes and tracks can)");
       fingerprint = fp;
     }
     if (fp != fingerprint) {

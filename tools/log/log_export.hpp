@@ -5,6 +5,9 @@
 //                           a KITTI-odometry-style folder (aerie-capture --source kitti reads it)
 //   aerie.gt_pose_t, aerie.pose_t -> DIR/<CHANNEL>.tum: "t x y z qx qy qz qw" per line
 //   aerie.gt_box_t       -> DIR/<CHANNEL>.csv: "t,visible,x,y,width,height"
+//   aerie.track_t        -> DIR/<CHANNEL>.csv: "t,seq,x,y,w,h,status,confidence", one row per frame, and
+//                           DIR/<CHANNEL>.txt: "x,y,w,h" per frame (OTB groundtruth_rect layout): the box's
+//                           top-left corner and size in pixels, 0-based; NaN when the tracker is IDLE
 #include <cstdint>
 #include <string>
 #include <vector>

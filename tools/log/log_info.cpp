@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
+#include <functional>
 #include <map>
 #include <optional>
 
@@ -10,12 +11,6 @@
 
 namespace aerie::logtools {
 namespace {
-
-std::string hex64(int64_t v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
-  return buf;
-}
 
 std::string format_time(int64_t utime) {
   const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
@@ -43,20 +38,41 @@ std::string json_escape(const std::string& s) {
   return o;
 }
 
+// Result types whose seq is that of the camera frame they answer, from a producer that answers
+// only some frames by design: aerie-vo publishes VO_POSE for the stereo pairs it processes (pairs
+// that arrive while its queue is full, or that it refuses, get none) and VO_DEPTH for one pair in
+// `depth_every`. Their seq gaps are frames without a result; every other seq counts messages.
+bool seq_follows_frames(const std::string& type) { return type == "aerie.pose_t" || type == "aerie.spherical_depth_t"; }
+
 struct Accumulator {
   ChannelSummary s;
   std::vector<std::string> types;
   std::optional<int64_t> last_seq;
   int64_t undecodable_since_seq = 0;  // corrupt messages since the last good seq
+  std::optional<int64_t> last_frames_skipped;
 };
+
+template <typename Count>
+int64_t sum(const std::vector<ChannelSummary>& channels, Count count) {
+  int64_t n = 0;
+  for (const auto& c : channels) n += count(c);
+  return n;
+}
+
+// "GT_POSE 1, VO_POSE 4" for the channels where count(c) > 0, or "none".
+template <typename Count>
+std::string per_channel(const std::vector<ChannelSummary>& channels, Count count) {
+  std::string list;
+  for (const auto& c : channels)
+    if (const int64_t n = count(c); n > 0) list += (list.empty() ? "" : ", ") + c.channel + " " + std::to_string(n);
+  return list.empty() ? "none" : list;
+}
 
 }  // namespace
 
-int64_t LogSummary::dropped() const {
-  int64_t n = 0;
-  for (const auto& c : channels) n += c.seq_gaps;
-  return n;
-}
+int64_t LogSummary::dropped() const { return sum(channels, std::mem_fn(&ChannelSummary::seq_gaps)); }
+int64_t LogSummary::logger_lost() const { return sum(channels, std::mem_fn(&ChannelSummary::logger_lost)); }
+int64_t LogSummary::producer_skipped() const { return sum(channels, std::mem_fn(&ChannelSummary::producer_skipped)); }
 
 LogSummary summarize(const std::string& path, bool resync) {
   logio::Reader reader(path, {.resync = resync});
@@ -88,8 +104,8 @@ LogSummary summarize(const std::string& path, bool resync) {
 
     const int64_t fp = fingerprint_of(ev.data.data(), ev.data.size());
     const TypeInfo* type = find_type(fp);
-    const std::string type_name = type ? type->name : "unknown (fingerprint " + hex64(fp) + ")";
-    if (std::find(a.types.begin(), a.types.end(), type_name) == a.types.end()) a.types.push_back(type_name);
+    const std::string name = type_name(type, fp, ev.channel);
+    if (std::find(a.types.begin(), a.types.end(), name) == a.types.end()) a.types.push_back(name);
     if (!type) continue;
     Stamp st;
     try {
@@ -97,15 +113,22 @@ LogSummary summarize(const std::string& path, bool resync) {
     } catch (const std::exception& e) {  // a decoder that throws: the payload is corrupt, the log goes on
       st = Stamp{};
       out.notes.push_back(path + ": event " + std::to_string(ev.event_number) + " on " + ev.channel + " (" +
-                          type_name + "): " + e.what());
+                          name + "): " + e.what());
     }
     if (!st.decoded) {
       ++c.undecodable;
       ++a.undecodable_since_seq;
       continue;
     }
+    if (st.frames_skipped) {  // cumulative: count what it grew by during the log (from 0 after a restart)
+      if (a.last_frames_skipped)
+        c.frames_skipped += *st.frames_skipped >= *a.last_frames_skipped ? *st.frames_skipped - *a.last_frames_skipped
+                                                                           : *st.frames_skipped;
+      a.last_frames_skipped = st.frames_skipped;
+    }
     if (!st.seq) continue;
     c.has_seq = true;
+    c.seq_follows_frames = seq_follows_frames(type->name);
     if (a.last_seq) {
       // A missing seq is a dropped message unless a corrupt message took its place.
       const int64_t missing = *st.seq - *a.last_seq - 1;
@@ -139,19 +162,29 @@ void print_summary(const LogSummary& s, std::ostream& out) {
     std::snprintf(line, sizeof line, "duration: %.3f s\n", s.duration_s);
     out << line;
   }
-  std::snprintf(line, sizeof line, "\n%-18s %-24s %8s %9s %10s %8s %11s %9s\n", "channel", "type", "count", "rate Hz",
-                "max gap s", "dropped", "MB", "corrupt");
+  std::snprintf(line, sizeof line, "\n%-18s %-24s %8s %9s %10s %8s %8s %11s %9s\n", "channel", "type", "count",
+                "rate Hz", "max gap s", "lost", "skipped", "MB", "corrupt");
   out << line;
   for (const auto& c : s.channels) {
-    std::snprintf(line, sizeof line, "%-18s %-24s %8lld %9.2f %10.3f %8s %11.2f %9lld\n", c.channel.c_str(),
-                  c.type.c_str(), static_cast<long long>(c.count), c.rate_hz, c.max_gap_s,
-                  c.has_seq ? std::to_string(c.seq_gaps).c_str() : "-", c.bytes / 1e6,
-                  static_cast<long long>(c.undecodable));
+    const std::string lost = c.has_seq ? std::to_string(c.logger_lost()) : "-";
+    const std::string skipped = c.has_seq || c.frames_skipped ? std::to_string(c.producer_skipped()) : "-";
+    std::snprintf(line, sizeof line, "%-18s %-24s %8lld %9.2f %10.3f %8s %8s %11.2f %9lld\n", c.channel.c_str(),
+                  c.type.c_str(), static_cast<long long>(c.count), c.rate_hz, c.max_gap_s, lost.c_str(),
+                  skipped.c_str(), c.bytes / 1e6, static_cast<long long>(c.undecodable));
     out << line;
   }
+  // A sequence gap is a message the logger lost or a frame its producer skipped by design.
+  const int64_t lost = s.logger_lost(), skipped = s.producer_skipped();
   out << "\ndropped messages (sequence gaps): " << s.dropped();
-  if (s.event_number_gaps) out << "; events missing from the logger's numbering: " << s.event_number_gaps;
-  out << "\n";
+  if (s.dropped() != lost) out << ", of which logger lost " << lost << ", skipped by producers " << s.dropped() - lost;
+  out << "\nlogger lost: " << lost;
+  if (lost)
+    out << " (published, never recorded: " << per_channel(s.channels, std::mem_fn(&ChannelSummary::logger_lost)) << ")";
+  out << "\nskipped by producers (by design, per channel): "
+      << per_channel(s.channels, std::mem_fn(&ChannelSummary::producer_skipped))
+      << (skipped ? " (camera frames without a result)\n" : "\n");
+  if (s.event_number_gaps)
+    out << "events missing from the log's numbering: " << s.event_number_gaps << " (taken out after recording)\n";
   for (const auto& c : s.channels)
     if (c.seq_restarts) out << "note: " << c.channel << ": sequence restarted " << c.seq_restarts << " time(s)\n";
   for (const auto& n : s.notes) out << "note: " << n << "\n";
@@ -168,7 +201,8 @@ void print_summary_json(const LogSummary& s, std::ostream& out) {
   out << "{\n  \"path\": \"" << json_escape(s.path) << "\",\n  \"file_size\": " << s.file_size
       << ",\n  \"events\": " << s.events << ",\n  \"first_utime\": " << s.first_utime
       << ",\n  \"last_utime\": " << s.last_utime << ",\n  \"duration_s\": " << s.duration_s
-      << ",\n  \"dropped\": " << s.dropped() << ",\n  \"event_number_gaps\": " << s.event_number_gaps
+      << ",\n  \"dropped\": " << s.dropped() << ",\n  \"logger_lost\": " << s.logger_lost()
+      << ",\n  \"producer_skipped\": " << s.producer_skipped() << ",\n  \"event_number_gaps\": " << s.event_number_gaps
       << ",\n  \"channels\": [";
   for (size_t i = 0; i < s.channels.size(); ++i) {
     const auto& c = s.channels[i];
@@ -177,6 +211,8 @@ void print_summary_json(const LogSummary& s, std::ostream& out) {
         << ", \"first_utime\": " << c.first_utime << ", \"last_utime\": " << c.last_utime
         << ", \"rate_hz\": " << c.rate_hz << ", \"max_gap_s\": " << c.max_gap_s
         << ", \"has_seq\": " << (c.has_seq ? "true" : "false") << ", \"seq_gaps\": " << c.seq_gaps
+        << ", \"seq_follows_frames\": " << (c.seq_follows_frames ? "true" : "false")
+        << ", \"logger_lost\": " << c.logger_lost() << ", \"producer_skipped\": " << c.producer_skipped()
         << ", \"seq_restarts\": " << c.seq_restarts << ", \"undecodable\": " << c.undecodable << "}";
   }
   out << "\n  ],\n  \"damage\": [";

@@ -1,15 +1,19 @@
-// aerie-log: inspect, export and cut LCM event logs (the lcm-logger format).
+// aerie-log: inspect, export, cut and compare LCM event logs (the lcm-logger format).
 //   aerie-log info LOG [--json] [--resync]
 //   aerie-log export LOG --channel C --out DIR [--resync] [--force]
 //   aerie-log cut LOG --from S --to S --out LOG2 [--resync] [--force]
+//   aerie-log diff A B [--channels C1,C2,...]
 // Exit status: 0 ok, 1 error (bad arguments, missing file/channel), 2 the log is
 // damaged (everything before the damage was still processed, and it is reported).
+// diff, as cmp(1): 0 the logs hold the same messages, 1 they differ, 2 usage error or a log
+// that cannot be read or is damaged.
 #include <CLI/CLI.hpp>
 
 #include <iostream>
 #include <limits>
 
 #include "tools/log/log_cut.hpp"
+#include "tools/log/log_diff.hpp"
 #include "tools/log/log_export.hpp"
 #include "tools/log/log_info.hpp"
 
@@ -23,21 +27,26 @@ int report_damage(const std::vector<aerie::logio::Damage>& damage) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Inspect, export and cut LCM event logs (lcm-logger format)", "aerie-log"};
+  CLI::App app{"Inspect, export, cut and compare LCM event logs (lcm-logger format)", "aerie-log"};
   app.require_subcommand(1);
-  std::string log, channel, out;
+  std::string log, log_b, channel, out;
+  std::vector<std::string> channels;
   bool json = false, resync = false, force = false;
   double from_s = 0, to_s = std::numeric_limits<double>::infinity();
 
-  auto* info = app.add_subcommand("info", "Channels, types, counts, rates, gaps, dropped messages, duration");
+  auto* info = app.add_subcommand("info", "Channels, types, counts, rates, gaps, duration; messages the logger "
+                                           "lost and frames producers skipped by design, told apart");
   info->add_option("log", log, "LCM log file")->required();
   info->add_flag("--json", json, "Print JSON instead of a table");
 
   auto* exp = app.add_subcommand("export", "Export a channel: images to PNG, stereo to left/right PNG folders, "
-                                           "poses to TUM trajectories, boxes to CSV");
+                                           "poses to TUM trajectories, boxes to CSV, tracks to OTB boxes");
   exp->add_option("log", log, "LCM log file")->required();
   exp->add_option("--channel", channel, "Channel to export")->required();
   exp->add_option("--out", out, "Output folder")->required();
+  exp->footer("Tracks (aerie.track_t) go to <CHANNEL>.csv (t,seq,x,y,w,h,status,confidence, one row per frame) and "
+              "<CHANNEL>.txt (x,y,w,h, the OTB groundtruth_rect layout): x,y the box's top-left corner, w,h its size, "
+              "in pixels, 0-based image coordinates; NaN while the tracker is IDLE.");
 
   auto* cut = app.add_subcommand("cut", "Copy a time range (seconds from the first event) into a new log");
   cut->add_option("log", log, "LCM log file")->required();
@@ -45,12 +54,41 @@ int main(int argc, char** argv) {
   cut->add_option("--to", to_s, "End, seconds from the first event (exclusive; default: the end)");
   cut->add_option("--out", out, "Output log file")->required();
 
+  auto* diff = app.add_subcommand("diff", "Compare two logs channel by channel: counts, identical messages, the "
+                                           "largest numeric field difference");
+  diff->add_option("A", log, "First LCM log file")->required();
+  diff->add_option("B", log_b, "Second LCM log file")->required();
+  diff->add_option("--channels", channels, "Channels to compare, comma-separated (default: every channel of A or B)")
+      ->delimiter(',')
+      ->allow_extra_args(false);  // one argument per --channels: `--channels X A B` leaves A and B positional
+  diff->footer("Messages are paired by their order within the channel: the i-th message of a channel in A with the "
+               "i-th in B (message 0 is the first), whatever their times. A pair is identical when the payloads are "
+               "equal byte for byte; for the catalogue types (lcmtypes/) the numeric fields of differing pairs are "
+               "compared too, and the largest absolute difference is shown with its field.\n"
+               "Exit status: 0 every compared channel is identical (same counts, every message identical), "
+               "1 they differ, 2 usage error or a log that cannot be read or is damaged.");
+
   for (auto* sub : {info, exp, cut})
     sub->add_flag("--resync", resync, "Skip damaged bytes to the next event header instead of stopping there");
   for (auto* sub : {exp, cut})
     sub->add_flag("--force", force, "Overwrite an existing output (refused otherwise)");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);  // prints the help or the error
+    return rc != 0 && diff->parsed() ? 2 : rc;
+  }
+  if (*diff) {
+    try {
+      const auto d = aerie::logtools::diff_logs(log, log_b, channels);
+      aerie::logtools::print_diff(d, std::cout);
+      return d.same() ? 0 : 1;
+    } catch (const std::exception& e) {
+      std::cerr << "aerie-log diff: " << e.what() << "\n";
+      return 2;
+    }
+  }
   try {
     if (*info) {
       const auto s = aerie::logtools::summarize(log, resync);

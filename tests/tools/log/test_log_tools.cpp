@@ -1,12 +1,19 @@
-// aerie-log's library: info (types by fingerprint, counts, rates, dropped messages,
-// corrupt payloads, damage), export (TUM trajectories, PNG images, a stereo channel
-// to a KITTI-style folder that the capture source reads back) and cut.
+// aerie-log's library: info (types by fingerprint, counts, rates, logger losses told apart
+// from producer skips, corrupt payloads, damage), export (TUM trajectories, PNG images, a
+// stereo channel to a KITTI-style folder that the capture source reads back, tracks to OTB
+// boxes), cut, and diff (also through the executable, for its exit status).
 #include <gtest/gtest.h>
 
 #include <aerie/gt_pose_t.hpp>
 #include <aerie/image_t.hpp>
+#include <aerie/pose_t.hpp>
 #include <aerie/stereo_image_t.hpp>
+#include <aerie/track_t.hpp>
 
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -14,12 +21,16 @@
 
 #include "air/capture/dataset_io.hpp"
 #include "air/capture/stereo_sequence_source.hpp"
+#include "air/track/eval/sequence.hpp"
+#include "common/bus/wire.hpp"
 #include "common/image/image_message.hpp"
 #include "common/logio/event_log.hpp"
 #include "tests/support/test_support.hpp"
 #include "tools/log/log_cut.hpp"
+#include "tools/log/log_diff.hpp"
 #include "tools/log/log_export.hpp"
 #include "tools/log/log_info.hpp"
+#include "tools/log/message_fields.hpp"
 
 namespace aerie::logtools {
 namespace {
@@ -317,6 +328,386 @@ TEST(LogInfo, AHostilePayloadIsCountedAsCorrupt) {
   EXPECT_EQ(s.events, 3);
   EXPECT_EQ(channel(s, "TRACK_CMD").undecodable, 1);
   EXPECT_TRUE(s.damage.empty());
+}
+
+
+aerie::track_t track(int64_t utime, int64_t seq, int8_t status, double x, double y, int64_t frames_skipped = 0) {
+  aerie::track_t m{};
+  m.utime = utime;
+  m.seq = seq;
+  m.tracker = "ipsl";
+  m.camera = "CAM_DOWN";
+  m.status = status;
+  if (status != aerie::track_t::IDLE) {
+    m.x = x;
+    m.y = y;
+    m.scale = 1;
+    m.width = 40;
+    m.height = 20;
+    m.confidence = 0.75f;
+  }
+  m.frames_skipped = frames_skipped;
+  return m;
+}
+
+aerie::track_level_t level(int n) {
+  aerie::track_level_t l{};
+  l.npoints = n;
+  for (int i = 0; i < n; ++i) {
+    l.u.push_back(static_cast<float>(i));
+    l.v.push_back(static_cast<float>(2 * i));
+    l.score.push_back(0.5f);
+  }
+  return l;
+}
+
+// What info tells apart: GT_POSE (own numbering) misses seq 4: the logger lost it. VO_POSE
+// copies the stereo pair's seq and has none for pairs 2, 5, 6: aerie-vo skipped them. TRACK
+// reports 4 skipped frames in frames_skipped. LCM's self-test string is there too, and two
+// events are missing from the numbering (taken out of the log after recording).
+TEST(LogInfo, LoggerLossIsToldApartFromProducerSkips) {
+  const auto dir = test::scratch_dir("log");
+  const auto path = (dir / "flight.lcm").string();
+  {
+    logio::Writer w(path);
+    logio::Event ev;
+    auto put = [&](int64_t utime, const std::string& channel, std::vector<uint8_t> data) {
+      ev.utime = utime;
+      ev.channel = channel;
+      ev.data = std::move(data);
+      w.write(ev, true);
+      ++ev.event_number;
+    };
+    const std::string self_test = "lcm self test";
+    put(0, "LCM_SELF_TEST", {self_test.begin(), self_test.end()});
+    const int64_t skipped[] = {2, 2, 3, 5, 5, 6};
+    for (int i = 0; i < 10; ++i) {
+      const int64_t t = 1'000'000 + 50'000 * i;
+      if (i != 4) put(t, "GT_POSE", encode(pose(t, i)));
+      if (i != 2 && i != 5 && i != 6) {
+        aerie::pose_t vo{};
+        vo.utime = t;
+        vo.seq = i;
+        vo.orientation[0] = 1;
+        put(t + 30'000, "VO_POSE", encode(vo));
+      }
+      if (i < 6) put(t + 40'000, "TRACK", encode(track(t, i, aerie::track_t::TRACKING, 100, 50, skipped[i])));
+      if (i == 7) ev.event_number += 2;
+    }
+    w.close();
+  }
+  const auto s = summarize(path);
+  EXPECT_EQ(s.event_number_gaps, 2);
+  const auto& gt = channel(s, "GT_POSE");
+  EXPECT_FALSE(gt.seq_follows_frames);
+  EXPECT_EQ(gt.logger_lost(), 1);
+  EXPECT_EQ(gt.producer_skipped(), 0);
+  const auto& vo = channel(s, "VO_POSE");
+  EXPECT_TRUE(vo.seq_follows_frames);
+  EXPECT_EQ(vo.seq_gaps, 3);
+  EXPECT_EQ(vo.logger_lost(), 0);
+  EXPECT_EQ(vo.producer_skipped(), 3);
+  const auto& tr = channel(s, "TRACK");
+  EXPECT_EQ(tr.seq_gaps, 0);
+  EXPECT_EQ(tr.frames_skipped, 4);  // 2 -> 6 during the log; the 2 before its first message are not counted
+  EXPECT_EQ(tr.producer_skipped(), 4);
+  EXPECT_EQ(s.dropped(), 4);
+  EXPECT_EQ(s.logger_lost(), 1);
+  EXPECT_EQ(s.producer_skipped(), 7);
+  EXPECT_EQ(channel(s, "LCM_SELF_TEST").type, "lcm self-test (string)");
+
+  std::ostringstream table, json;
+  print_summary(s, table);
+  print_summary_json(s, json);
+  const std::string t = table.str();
+  const auto has = [&](const std::string& text) { return t.find(text) != std::string::npos; };
+  EXPECT_TRUE(has("dropped messages (sequence gaps): 4, of which logger lost 1, skipped by producers 3\n")) << t;
+  EXPECT_TRUE(has("\nlogger lost: 1 (published, never recorded: GT_POSE 1)\n")) << t;
+  EXPECT_TRUE(has("\nskipped by producers (by design, per channel): TRACK 4, VO_POSE 3 (camera frames without a "
+                  "result)\n"))
+      << t;
+  EXPECT_NE(t.find("events missing from the log's numbering: 2"), std::string::npos) << t;
+  EXPECT_NE(t.find("LCM_SELF_TEST      lcm self-test (string)"), std::string::npos) << t;
+  EXPECT_EQ(t.find("unknown"), std::string::npos) << t;
+  EXPECT_NE(json.str().find("\"logger_lost\": 1,"), std::string::npos) << json.str();
+  EXPECT_NE(json.str().find("\"producer_skipped\": 7,"), std::string::npos) << json.str();
+}
+
+TEST(LogInfo, NothingLostNothingSkipped) {
+  const auto dir = test::scratch_dir("log");
+  const auto path = (dir / "clean.lcm").string();
+  {
+    logio::Writer w(path);
+    for (int i = 0; i < 3; ++i) {
+      const auto b = encode(pose(1000 * i, i));
+      w.write(1000 * i, "GT_POSE", b.data(), b.size());
+    }
+  }
+  std::ostringstream out;
+  print_summary(summarize(path), out);
+  EXPECT_NE(out.str().find("dropped messages (sequence gaps): 0\nlogger lost: 0\n"
+                           "skipped by producers (by design, per channel): none\n"),
+            std::string::npos)
+      << out.str();
+}
+
+// One row per TRACK message; the OTB file holds the top-left corner and size, NaN while IDLE,
+// and reads back with the OTB reader the tracker benchmark uses.
+TEST(LogExport, TrackToOtbBoxes) {
+  const auto dir = test::scratch_dir("log");
+  const auto path = (dir / "track.lcm").string();
+  {
+    logio::Writer w(path);
+    const int8_t status[] = {aerie::track_t::IDLE, aerie::track_t::TRACKING, aerie::track_t::TRACKING,
+                             aerie::track_t::LOST};
+    for (int i = 0; i < 4; ++i) {
+      const auto b = encode(track(1'700'000'000'000'000 + 50'000 * i, i, status[i], 100.5 + i, 60));
+      w.write(50'000 * i, "TRACK", b.data(), b.size());
+    }
+  }
+  const auto r = export_channel(path, "TRACK", (dir / "out").string());
+  EXPECT_EQ(r.type, "aerie.track_t");
+  EXPECT_EQ(r.exported, 4);
+  std::ifstream csv(dir / "out/TRACK.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(csv, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[0], "t,seq,x,y,w,h,status,confidence");
+  EXPECT_EQ(rows[1], "1700000000.000000,0,NaN,NaN,NaN,NaN,IDLE,0.000");
+  EXPECT_EQ(rows[2], "1700000000.050000,1,81.500,50.000,40.000,20.000,TRACKING,0.750");
+  EXPECT_EQ(rows[4], "1700000000.150000,3,83.500,50.000,40.000,20.000,LOST,0.750");
+  const auto boxes = track::eval::read_boxes(dir / "out/TRACK.txt");
+  ASSERT_EQ(boxes.size(), 4u);
+  EXPECT_FALSE(track::eval::is_valid_box(boxes[0]));
+  EXPECT_EQ(boxes[2], cv::Rect2d(82.5, 50, 40, 20));  // centre (102.5, 60), 40 x 20
+}
+
+TEST(MessageFields, NamesTheFieldOfTheLargestDifference) {
+  auto a = track(1000, 3, aerie::track_t::TRACKING, 100, 50);
+  a.levels = {level(2), level(3)};
+  a.nlevels = 2;
+  auto b = a;
+  b.x += 2.5;
+  b.levels[1].u[2] += 3.5f;
+  b.tracker = "ct";
+  auto ea = encode(a), eb = encode(b);
+  auto f = compare_fields(ea.data(), ea.size(), eb.data(), eb.size());
+  ASSERT_TRUE(f.comparable);
+  EXPECT_EQ(f.type, "aerie.track_t");
+  EXPECT_EQ(f.field, "levels[1].u[2]");
+  EXPECT_DOUBLE_EQ(f.max_abs, 3.5);
+  EXPECT_EQ(f.text, "tracker");
+  EXPECT_EQ(f.shape, "");
+
+  b.corners[2][1] = 7;  // a two-dimensional array: row-major indices
+  b.levels.pop_back();  // levels cannot be paired any more: reported, skipped
+  b.nlevels = 1;
+  eb = encode(b);
+  f = compare_fields(ea.data(), ea.size(), eb.data(), eb.size());
+  EXPECT_EQ(f.field, "corners[2][1]");
+  EXPECT_DOUBLE_EQ(f.max_abs, 7);
+  EXPECT_EQ(f.shape, "levels: 2 vs 1 elements");
+
+  b = a;
+  b.confidence = NAN;
+  eb = encode(b);
+  f = compare_fields(ea.data(), ea.size(), eb.data(), eb.size());
+  EXPECT_EQ(f.field, "confidence");
+  EXPECT_TRUE(std::isinf(f.max_abs));
+
+  const std::string text = "not a message";
+  const auto* bytes = reinterpret_cast<const uint8_t*>(text.data());
+  EXPECT_FALSE(compare_fields(ea.data(), ea.size(), bytes, text.size()).comparable);
+  ea.resize(ea.size() - 3);  // truncated: does not decode
+  EXPECT_FALSE(compare_fields(ea.data(), ea.size(), eb.data(), eb.size()).comparable);
+}
+
+// B: the log of make_log with GT_POSE message 6 moved by 0.75 m in y, one pixel of the right
+// image of stereo pair 3 changed by 64, and the last CAM_LEFT image missing.
+fs::path make_changed_log(const fs::path& a, const fs::path& dir) {
+  const auto path = dir / "changed.lcm";
+  const auto events = logio::read_all(a.string()).events;
+  logio::Writer w(path.string());
+  int64_t gt = 0, stereo_pairs = 0, cam = 0;
+  for (auto ev : events) {
+    if (ev.channel == "GT_POSE" && gt++ == 6) {
+      auto p = bus::decode_bounded<aerie::gt_pose_t>(ev.data.data(), ev.data.size());
+      p.position[1] += 0.75;
+      ev.data = encode(p);
+    }
+    if (ev.channel == "CAM_STEREO" && stereo_pairs++ == 3) {
+      auto st = bus::decode_bounded<aerie::stereo_image_t>(ev.data.data(), ev.data.size());
+      st.right.data[123] ^= 0x40;  // 64 brighter or darker
+      ev.data = encode(st);
+    }
+    if (ev.channel == "CAM_LEFT" && ++cam == 20) continue;
+    w.write(ev);
+  }
+  return path;
+}
+
+const ChannelDiff& channel(const LogDiff& d, const std::string& name) {
+  for (const auto& c : d.channels)
+    if (c.channel == name) return c;
+  throw std::runtime_error("no channel " + name);
+}
+
+TEST(LogDiff, IdenticalLogs) {
+  const auto a = make_log(test::scratch_dir("a")), b = make_log(test::scratch_dir("b"));
+  const auto d = diff_logs(a.string(), b.string());
+  EXPECT_TRUE(d.same());
+  ASSERT_EQ(d.channels.size(), 4u);
+  EXPECT_EQ(channel(d, "GT_POSE").identical, 19);
+  EXPECT_EQ(channel(d, "CAM_LEFT").identical, 20);  // the corrupt one too: the same bytes
+  std::ostringstream out;
+  print_diff(d, out);
+  EXPECT_NE(out.str().find("same: every message of the 4 channel(s) compared is identical"), std::string::npos)
+      << out.str();
+}
+
+TEST(LogDiff, CountsIdenticalMessagesAndTheLargestFieldDifference) {
+  const auto dir = test::scratch_dir("log");
+  const auto a = make_log(dir);
+  const auto b = make_changed_log(a, dir);
+  const auto d = diff_logs(a.string(), b.string());
+  EXPECT_FALSE(d.same());
+  const auto& gt = channel(d, "GT_POSE");
+  EXPECT_EQ(gt.type, "aerie.gt_pose_t");
+  EXPECT_EQ(gt.count_a, 19);
+  EXPECT_EQ(gt.count_b, 19);
+  EXPECT_EQ(gt.identical, 18);
+  EXPECT_EQ(gt.field, "position[1]");
+  EXPECT_NEAR(gt.max_abs, 0.75, 1e-12);
+  EXPECT_EQ(gt.at, 6);
+  EXPECT_FALSE(gt.same());
+  const auto& st = channel(d, "CAM_STEREO");
+  EXPECT_EQ(st.identical, 19);
+  EXPECT_EQ(st.field, "right.data[123]");
+  EXPECT_EQ(st.at, 3);
+  EXPECT_EQ(st.max_abs, 64);
+  const auto& cam = channel(d, "CAM_LEFT");
+  EXPECT_EQ(cam.count_a, 20);
+  EXPECT_EQ(cam.count_b, 19);
+  EXPECT_EQ(cam.identical, 19);
+  EXPECT_FALSE(cam.same());
+  EXPECT_TRUE(channel(d, "RAW").same());
+  EXPECT_NE(channel(d, "RAW").type.find("unknown"), std::string::npos);
+
+  std::ostringstream out;
+  print_diff(d, out);
+  EXPECT_NE(out.str().find("GT_POSE            aerie.gt_pose_t                19       19         18  position[1] 0.75 "
+                           "(message 6)\n"),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("different: 3 of 4 channel(s): CAM_LEFT, CAM_STEREO, GT_POSE"), std::string::npos)
+      << out.str();
+
+  const auto only = diff_logs(a.string(), b.string(), {"RAW", "CAM_LEFT"});
+  ASSERT_EQ(only.channels.size(), 2u);
+  EXPECT_FALSE(only.same());
+  EXPECT_TRUE(diff_logs(a.string(), b.string(), {"RAW"}).same());
+  try {
+    diff_logs(a.string(), b.string(), {"RAW", "VO_POSE"});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no channel VO_POSE in "), std::string::npos) << e.what();
+  }
+}
+
+// Messages are paired by order: a message missing from the middle of a channel shifts the
+// pairs after it, and the note says what no number shows.
+TEST(LogDiff, PairsByOrderWithinTheChannel) {
+  const auto dir = test::scratch_dir("log");
+  auto write = [&](const std::string& name, std::vector<aerie::track_t> msgs) {
+    logio::Writer w((dir / name).string());
+    for (const auto& m : msgs) {
+      const auto b = encode(m);
+      w.write(m.utime, "TRACK", b.data(), b.size());
+    }
+    return (dir / name).string();
+  };
+  auto t0 = track(0, 0, aerie::track_t::TRACKING, 10, 10), t1 = track(100, 1, aerie::track_t::TRACKING, 11, 10),
+       t2 = track(200, 2, aerie::track_t::TRACKING, 12, 10);
+  const auto a = write("a.lcm", {t0, t1, t2});
+  t1.levels = {level(1)};
+  t1.nlevels = 1;
+  const auto b = write("b.lcm", {t0, t1});
+  const auto d = diff_logs(a, b);
+  const auto& c = channel(d, "TRACK");
+  EXPECT_EQ(c.count_a, 3);
+  EXPECT_EQ(c.count_b, 2);
+  EXPECT_EQ(c.identical, 1);
+  EXPECT_EQ(c.field, "nlevels");  // message 1: only the levels differ, and their count
+  EXPECT_EQ(c.max_abs, 1);
+  EXPECT_EQ(c.at, 1);
+  EXPECT_EQ(c.note, "message 1: levels: 0 vs 1 elements");
+}
+
+TEST(LogDiff, ADamagedOrMissingLogIsRefusedNamingTheFile) {
+  const auto dir = test::scratch_dir("log");
+  const auto a = make_log(dir);
+  const auto b = dir / "cut_short.lcm";
+  fs::copy_file(a, b);
+  fs::resize_file(b, fs::file_size(b) - 10);
+  try {
+    diff_logs(a.string(), b.string());
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(b.string() + ": truncated at byte"), std::string::npos) << m;
+  }
+  try {
+    diff_logs(a.string(), (dir / "nope.lcm").string());
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nope.lcm: no such log file"), std::string::npos) << e.what();
+  }
+}
+
+struct Run {
+  int status;
+  std::string out, err;
+};
+
+Run aerie_log(const std::string& args, const fs::path& dir) {
+  const auto out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = (test::binary_dir() / "bin" / "aerie-log").string() + " " + args + " > " + out.string() +
+                          " 2> " + err.string();
+  const int rc = std::system(cmd.c_str());
+  auto slurp = [](const fs::path& p) {
+    std::ifstream in(p);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(out), slurp(err)};
+}
+
+// The exit status is the interface scripts use: 0 same, 1 different, 2 usage or unreadable log.
+TEST(LogDiff, ExitStatusOfTheCommand) {
+  const auto dir = test::scratch_dir("log");
+  const auto a = make_log(dir);
+  const auto b = make_changed_log(a, dir);
+  const auto run_dir = test::scratch_dir("run");
+  EXPECT_EQ(aerie_log("diff " + a.string() + " " + a.string(), run_dir).status, 0);
+  const auto differ = aerie_log("diff " + a.string() + " " + b.string(), run_dir);
+  EXPECT_EQ(differ.status, 1);
+  EXPECT_NE(differ.out.find("position[1] 0.75 (message 6)"), std::string::npos) << differ.out;
+  EXPECT_EQ(aerie_log("diff " + a.string() + " " + b.string() + " --channels RAW,CAM_STEREO", run_dir).status, 1);
+  EXPECT_EQ(aerie_log("diff " + a.string() + " " + b.string() + " --channels RAW", run_dir).status, 0);
+  EXPECT_EQ(aerie_log("diff --channels RAW " + a.string() + " " + b.string(), run_dir).status, 0);
+
+  const auto missing = aerie_log("diff " + a.string() + " " + (dir / "nope.lcm").string(), run_dir);
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.err.find("nope.lcm: no such log file"), std::string::npos) << missing.err;
+  fs::resize_file(b, fs::file_size(b) - 10);
+  const auto truncated = aerie_log("diff " + a.string() + " " + b.string(), run_dir);
+  EXPECT_EQ(truncated.status, 2);
+  EXPECT_NE(truncated.err.find(b.string() + ": truncated at byte"), std::string::npos) << truncated.err;
+  EXPECT_EQ(aerie_log("diff " + a.string(), run_dir).status, 2);  // B missing
+  EXPECT_EQ(aerie_log("diff " + a.string() + " " + a.string() + " --bogus", run_dir).status, 2);
+  EXPECT_EQ(aerie_log("diff " + a.string() + " " + a.string() + " --channels NOPE", run_dir).status, 2);
+  const auto help = aerie_log("diff --help", run_dir);
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("paired by their order within the channel"), std::string::npos) << help.out;
 }
 
 }  // namespace
