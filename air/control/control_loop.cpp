@@ -11,6 +11,9 @@ namespace aerie::control {
 void ControlConfig::validate() const {
   if (!std::isfinite(reference_deg)) throw std::invalid_argument("control: reference_deg must be finite");
   if (!(forward_speed_m_s >= 0.0 && forward_speed_m_s < 20.0)) throw std::invalid_argument("control: forward_speed_m_s must be in [0, 20)");
+  if (!(activation_distance_m >= 0.0 && activation_distance_m <= 1000.0))
+    throw std::invalid_argument("control: activation_distance_m must be in [0, 1000] m, got " +
+                                std::to_string(activation_distance_m));
   if (!(stale_timeout_s > 0.0 && stale_timeout_s <= 60.0))
     throw std::invalid_argument("control: stale_timeout_s must be in (0, 60] s, got " + std::to_string(stale_timeout_s));
   if (!(limits.max_yaw_rate_deg_s > 0.0 && limits.max_yaw_rate_deg_s <= 720.0))
@@ -28,16 +31,23 @@ bool ControlLoop::stale(int64_t now_us) const {
   return !have_input_ || static_cast<double>(now_us - last_receive_) > cfg_.stale_timeout_s * 1e6;
 }
 
-bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us) {
-  if (!std::isfinite(heading_deg)) return false;
+bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us,
+                             const std::optional<Eigen::Vector3d>& position) {
+  if (!std::isfinite(heading_deg) || (position && !position->allFinite())) return false;
   if (have_time_ && utime <= last_utime_) return false;
   // Input resumed after going stale: the derivative and integral start afresh.
   if (have_input_ && stale(receive_wall_us)) loop_.reset();
   if (!have_reference_) {
     reference_ = cfg_.reference_relative ? flc::wrap_deg(heading_deg + cfg_.reference_deg) : cfg_.reference_deg;
     have_reference_ = true;
+    start_ = position;
   }
-  const double u = loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_);
+  // The turn starts at the end of the normal flight area; until then the FLC is not run
+  // (as in aerie-ceopt's scenario) and the vehicle flies straight.
+  if (!turning_)
+    turning_ = cfg_.activation_distance_m <= 0.0 ||
+               (position && start_ && (*position - *start_).norm() >= cfg_.activation_distance_m);
+  const double u = turning_ ? loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_) : 0.0;
   have_input_ = have_time_ = true;
   last_utime_ = utime;
   last_receive_ = receive_wall_us;
@@ -46,7 +56,7 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
   active_.forward_speed_m_s = cfg_.forward_speed_m_s;
   active_.heading_deg = heading_deg;
   active_.reference_deg = reference_;
-  active_.error_deg = loop_.inputs()[0];
+  active_.error_deg = turning_ ? loop_.inputs()[0] : flc::wrap_deg(reference_ - heading_deg);
   active_.source_utime = utime;
   return true;
 }

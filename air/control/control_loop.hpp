@@ -3,6 +3,8 @@
 // measurements in, FLC yaw-rate commands out, with command limits, a controller that
 // can be replaced at run time after validation, and a hover fallback when the input
 // goes stale.
+#include <Eigen/Core>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -19,6 +21,10 @@ struct ControlConfig {
   bool reference_relative = true;     // reference is relative to the first heading received
   double forward_speed_m_s = 0.0;     // forward speed commanded while active
   double stale_timeout_s = 0.5;       // no heading for longer than this -> fallback hover
+  // > 0: the avoidance of thesis 5.1.2 — fly straight ahead (zero yaw rate) until the pose has
+  // moved this far from the first one (the normal flight area), then turn to the reference.
+  // 0: the reference applies from the first heading.
+  double activation_distance_m = 0.0;
   flc::CommandLimits limits;
   void validate() const;              // throws std::invalid_argument
 };
@@ -39,7 +45,9 @@ class ControlLoop {
   // A heading measurement: utime of its source frame (message time, drives the FLC's
   // derivative and integral) and the wall-clock time it was received (for staleness).
   // Returns false (and ignores it) if it is not newer than the last one or not finite.
-  bool on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us);
+  // `position` (any fixed frame, m) is the pose's; activation_distance_m measures it.
+  bool on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us,
+                  const std::optional<Eigen::Vector3d>& position = std::nullopt);
 
   // The heading source re-synchronised to a new time base (restart, outage; util::MessageClock):
   // the next heading is taken whatever its utime, and the derivative and integral start afresh.
@@ -55,12 +63,15 @@ class ControlLoop {
   const flc::FlcSpec& controller() const { return loop_.flc().spec(); }
   const ControlConfig& config() const { return cfg_; }
   bool stale(int64_t now_us) const;
+  bool turning() const { return turning_; }  // past the activation distance (or none configured)
 
  private:
   ControlConfig cfg_;
   flc::HeadingLoop loop_;
   bool have_input_ = false, have_reference_ = false, have_time_ = false;
   double reference_ = 0.0;
+  bool turning_ = false;
+  std::optional<Eigen::Vector3d> start_;  // the first pose's position
   int64_t last_utime_ = 0, last_receive_ = 0;
   Command active_;
 };

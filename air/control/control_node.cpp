@@ -37,14 +37,36 @@ flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::Fl
   return spec;
 }
 
+std::string default_pose_channel(NodeOptions::Input input) {
+  switch (input) {
+    case NodeOptions::Input::kVoPose: return channels::kVoPose;
+    case NodeOptions::Input::kNavState: return channels::kNavState;
+    case NodeOptions::Input::kGtPose: return channels::kGtPose;
+  }
+  return channels::kVoPose;
+}
+
+HeadingFrame default_heading_frame(NodeOptions::Input input) {
+  HeadingFrame f;  // VO: its world is its first camera frame (y down), the camera's optical axis
+  if (input == NodeOptions::Input::kGtPose) {  // simulators publish a z-up world, y toward the wall
+    f.up = {0, 0, 1};
+    f.forward = {0, 1, 0};
+  } else if (input == NodeOptions::Input::kNavState) {  // gravity-aligned z-up world, the body's x forward
+    f.up = {0, 0, 1};
+    f.forward = {1, 0, 0};
+    f.axis = {1, 0, 0};
+  }
+  return f;
+}
+
 namespace {
 
 NodeOptions checked(NodeOptions o) {
-  if (!(o.rate_hz > 0.0 && o.rate_hz <= 1000.0)) throw std::invalid_argument("control: rate_hz must be in (0, 1000]");
+  if (!(o.rate_hz >= 0.0 && o.rate_hz <= 1000.0))
+    throw std::invalid_argument("control: rate_hz must be in [0, 1000] (0 = one command per input)");
   o.frame.validate();
   o.control.validate();
-  if (o.pose_channel.empty())
-    o.pose_channel = o.input == NodeOptions::Input::kVoPose ? channels::kVoPose : channels::kGtPose;
+  if (o.pose_channel.empty()) o.pose_channel = default_pose_channel(o.input);
   o.message_time.stale_timeout_us = static_cast<int64_t>(std::llround(o.control.stale_timeout_s * 1e6));
   return o;
 }
@@ -59,30 +81,49 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
       loop_(std::move(controller), opt_.control),
       now_(std::move(now)),
       pose_clock_(status, opt_.pose_channel, opt_.message_time) {
-  period_us_ = static_cast<int64_t>(1e6 / opt_.rate_hz);
-  const bool vo = opt_.input == NodeOptions::Input::kVoPose;
-  if (vo) {
-    bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
-      if (m.status != aerie::pose_t::OK) {
-        status_.count("pose_not_ok");  // initialising/lost: no heading, the fallback takes over when stale
-        return;
-      }
-      on_pose(m.utime, m.orientation);
-    });
-  } else {
-    bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
-      on_pose(m.utime, m.orientation);
-    });
+  period_us_ = opt_.rate_hz > 0 ? static_cast<int64_t>(1e6 / opt_.rate_hz) : 0;
+  switch (opt_.input) {
+    case NodeOptions::Input::kVoPose:
+      bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
+        if (m.status == aerie::pose_t::OK)
+          on_pose(m.utime, m.orientation, m.position);
+        else
+          status_.count("pose_not_ok");  // initialising/lost: no heading, the fallback takes over when stale
+        answer();
+      });
+      break;
+    case NodeOptions::Input::kNavState:
+      bus_.subscribe<aerie::nav_state_t>(opt_.pose_channel, [this](const aerie::nav_state_t& m, const bus::ReceiveInfo&) {
+        // IMU_ONLY is the filter bridging a VO outage within its configured time: still flown on.
+        if (m.status == aerie::nav_state_t::OK || m.status == aerie::nav_state_t::IMU_ONLY)
+          on_pose(m.utime, m.orientation, m.position);
+        else
+          status_.count("nav_not_ok");  // initialising/lost
+        answer();
+      });
+      break;
+    case NodeOptions::Input::kGtPose:
+      bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
+        on_pose(m.utime, m.orientation, m.position);
+        answer();
+      });
+      break;
   }
   bus_.subscribe<aerie::flc_params_t>(opt_.params_channel,
                                       [this](const aerie::flc_params_t& m, const bus::ReceiveInfo&) { on_params(m); });
   status_.ok("controller " + loop_.controller().id);
 }
 
-void ControlNode::on_pose(int64_t utime, const double orientation[4]) {
+void ControlNode::answer() {
+  if (period_us_ == 0) publish_command(now_());
+}
+
+void ControlNode::on_pose(int64_t utime, const double orientation[4], const double position[3]) {
   double heading = 0.0;
   try {
     heading = heading_from_quaternion(orientation, opt_.frame);
+    if (!std::isfinite(position[0]) || !std::isfinite(position[1]) || !std::isfinite(position[2]))
+      throw std::invalid_argument("position is not finite");
   } catch (const std::invalid_argument& e) {
     // Counted, shown in the status, logged once per 100 so that a wrong frame does not flood the log.
     status_.count("bad_pose");
@@ -91,17 +132,17 @@ void ControlNode::on_pose(int64_t utime, const double orientation[4]) {
       spdlog::warn("pose on {}: {} ({} so far; check heading_frame)", opt_.pose_channel, e.what(), bad_poses_);
     return;
   }
-  on_heading(utime, heading, now_());
+  on_heading(utime, heading, {position[0], position[1], position[2]}, now_());
 }
 
-void ControlNode::on_heading(int64_t utime, double heading_deg, int64_t receive_us) {
+void ControlNode::on_heading(int64_t utime, double heading_deg, const Eigen::Vector3d& position, int64_t receive_us) {
   // A pose whose time jumps (utime = INT64_MAX, a restarted VO) is held and counted
   // ("<channel>.time_jumps") without touching the loop; after resync_messages consistent
   // ones the loop follows the new time base.
   const auto time = pose_clock_.observe(utime, receive_us);
   if (!time.accepted()) return;
   if (time.verdict == util::MessageClock::Verdict::kResynced) loop_.resync();
-  if (!loop_.on_heading(utime, heading_deg, receive_us)) {
+  if (!loop_.on_heading(utime, heading_deg, receive_us, position)) {
     status_.count("pose_out_of_order");
     return;
   }
@@ -129,7 +170,7 @@ void ControlNode::on_params(const aerie::flc_params_t& m) {
 }
 
 void ControlNode::tick(int64_t now_us) {
-  if (now_us < next_publish_) return;
+  if (period_us_ == 0 || now_us < next_publish_) return;
   publish_command(now_us);
   // Keep the fixed rate; after a long pause start again from now.
   next_publish_ = now_us - next_publish_ > period_us_ ? now_us + period_us_ : next_publish_ + period_us_;

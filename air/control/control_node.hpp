@@ -1,10 +1,12 @@
 #pragma once
-// aerie-control's LCM side: VO_POSE (or GT_POSE) in, CTRL_CMD out at a fixed rate,
+// aerie-control's LCM side: VO_POSE, NAV_STATE or GT_POSE in, CTRL_CMD out at a fixed rate
+// (or one per input message, for lock-step and replay),
 // new controllers from FLC_PARAMS (validated; a bad one is refused with its reason
 // and the current one stays), status on STATUS_CONTROL.
 #include <aerie/control_cmd_t.hpp>
 #include <aerie/flc_params_t.hpp>
 #include <aerie/gt_pose_t.hpp>
+#include <aerie/nav_state_t.hpp>
 #include <aerie/pose_t.hpp>
 
 #include <string>
@@ -19,17 +21,22 @@
 namespace aerie::control {
 
 struct NodeOptions {
-  enum class Input { kVoPose, kGtPose };
+  enum class Input { kVoPose, kNavState, kGtPose };
   Input input = Input::kVoPose;
-  std::string pose_channel;           // "" = VO_POSE or GT_POSE by input
+  std::string pose_channel;           // "" = VO_POSE, NAV_STATE or GT_POSE by input
   std::string params_channel = "FLC_PARAMS";
   std::string command_channel = "CTRL_CMD";
-  double rate_hz = 30.0;              // CTRL_CMD rate
+  double rate_hz = 30.0;              // CTRL_CMD rate; 0 = one command per message on the pose channel
   HeadingFrame frame;
   ControlConfig control;
   // message_time.max_jump_s / resync_messages; its stale timeout is control.stale_timeout_s.
   util::MessageClockConfig message_time;
 };
+
+// VO_POSE, NAV_STATE or GT_POSE.
+std::string default_pose_channel(NodeOptions::Input input);
+// How each input's orientation becomes a heading by default (config/control.yaml, heading_frame).
+HeadingFrame default_heading_frame(NodeOptions::Input input);
 
 // The controller a FLC_PARAMS message describes: its FLL if it has one, else the
 // current controller; then its named parameters; its id. Throws with the reason.
@@ -42,14 +49,16 @@ class ControlNode {
   ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options,
               util::NodeClock now = util::wall_utime);
 
-  // Publishes a command when a period of the rate has elapsed since the last one.
+  // Publishes a command when a period of the rate has elapsed since the last one (nothing
+  // when rate_hz is 0: commands then follow the input).
   void tick(int64_t now_us);
   void publish_command(int64_t now_us);
   const ControlLoop& loop() const { return loop_; }
 
  private:
-  void on_pose(int64_t utime, const double orientation[4]);
-  void on_heading(int64_t utime, double heading_deg, int64_t receive_us);
+  void on_pose(int64_t utime, const double orientation[4], const double position[3]);
+  void on_heading(int64_t utime, double heading_deg, const Eigen::Vector3d& position, int64_t receive_us);
+  void answer();  // rate_hz 0: the command that follows an input message
   void on_params(const aerie::flc_params_t& m);
 
   bus::Bus& bus_;

@@ -16,17 +16,18 @@
 using namespace aerie;
 
 int main(int argc, char** argv) {
-  CLI::App app{"aerie-control: fuzzy heading controller (VO_POSE/GT_POSE -> CTRL_CMD, FLC_PARAMS at run time)"};
+  CLI::App app{"aerie-control: fuzzy heading controller (VO_POSE/NAV_STATE/GT_POSE -> CTRL_CMD, FLC_PARAMS at run time)"};
   util::CommonOptions common;
   util::add_common_options(app, common);
   control::CliOverrides cli;
   app.add_option("--controller", cli.controller, "controller file (.yaml or .fll); default: config or the thesis' initial FLC");
-  app.add_option("--input", cli.input, "heading source: vo (VO_POSE, aerie.pose_t) or gt (GT_POSE, aerie.gt_pose_t)")
-      ->check(CLI::IsMember({"vo", "gt"}));
-  app.add_option("--pose-channel", cli.pose_channel, "pose channel (default VO_POSE or GT_POSE)");
+  app.add_option("--input", cli.input, "heading source: vo (VO_POSE, aerie.pose_t), nav (NAV_STATE, aerie.nav_state_t: VO + IMU) "
+                 "or gt (GT_POSE, aerie.gt_pose_t)")
+      ->check(CLI::IsMember({"vo", "nav", "gt"}));
+  app.add_option("--pose-channel", cli.pose_channel, "pose channel (default VO_POSE, NAV_STATE or GT_POSE)");
   app.add_option("--reference", cli.reference_deg, "heading reference in degrees");
   app.add_option("--speed", cli.forward_speed, "forward speed commanded while active (m/s)");
-  app.add_option("--rate", cli.rate_hz, "CTRL_CMD rate (Hz)");
+  app.add_option("--rate", cli.rate_hz, "CTRL_CMD rate (Hz); 0 = one command per input message");
   app.add_option("--stale-timeout", cli.stale_timeout_s, "hover when no heading for this long (s)");
   CLI11_PARSE(app, argc, argv);
   util::init_logging("control", common.log_level);
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
     control::ControlNode node(bus, status, setup.controller, setup.options);
     spdlog::info("controller '{}' ({} rules), input {} on {}, CTRL_CMD at {} Hz, reference {} deg{}, stale after {} s",
                  setup.controller.id, setup.controller.rules.size(),
-                 setup.options.input == control::NodeOptions::Input::kVoPose ? "vo" : "gt",
+                 cli.input.empty() ? cfg.get<std::string>("input", "vo") : cli.input,
                  setup.options.pose_channel, setup.options.rate_hz,
                  setup.options.control.reference_deg, setup.options.control.reference_relative ? " (relative)" : "",
                  setup.options.control.stale_timeout_s);

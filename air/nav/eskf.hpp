@@ -93,7 +93,9 @@ struct EskfParams {
   // Camera-IMU extrinsic: the left camera's pose in the body frame.
   geometry::SE3 T_body_cam;
   // VO measurement noise.
-  VoNoise vo_noise = VoNoise::Message;      // Message: pose_t's covariance (configured noise if not positive definite)
+  // Config: the sigmas below (default; aerie-vo's accumulated covariance is overconfident, docs/nav.md).
+  // Message: pose_t's covariance (the configured noise where it is not positive definite).
+  VoNoise vo_noise = VoNoise::Config;
   double vo_rotation_sigma_rad = 0.0175;    // configured noise, 1 sigma per axis
   double vo_position_sigma_m = 0.02;
   VoFrame vo_frame = VoFrame::Anchor;

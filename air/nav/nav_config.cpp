@@ -97,7 +97,7 @@ NavConfig load_nav_config(const util::Config& cfg) {
   struct Vo {
     std::string noise, frame;
     double rotation_sigma_deg, position_sigma_m, gate_chi2;
-  } v{"message", "anchor", e.vo_rotation_sigma_rad / kDeg, e.vo_position_sigma_m, e.gate_chi2};
+  } v{e.vo_noise == VoNoise::Message ? "message" : "config", "anchor", e.vo_rotation_sigma_rad / kDeg, e.vo_position_sigma_m, e.gate_chi2};
   util::SectionReader<Vo>(vo, v)("noise", &Vo::noise)("frame", &Vo::frame)("rotation_sigma_deg", &Vo::rotation_sigma_deg)(
       "position_sigma_m", &Vo::position_sigma_m)("gate_chi2", &Vo::gate_chi2)
       .known("T_world_vo")

@@ -12,19 +12,17 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
 #include <numeric>
 #include <opencv2/core.hpp>
-#include <thread>
 
 #include "air/pilot/pilot_config.hpp"
 #include "air/track/factory.hpp"
 #include "common/logio/event_log.hpp"
 #include "common/sim/flight/flight_config.hpp"
+#include "bench/seeded_runs.hpp"
 #include "tools/landing/landing_run.hpp"
 
 using namespace aerie;
@@ -180,24 +178,8 @@ int main(int argc, char** argv) {
   int failures = 0;
   for (const auto& s : setups) {
     const landing::RunConfig config = setup_config(s, files);
-    std::vector<landing::RunResult> results(static_cast<size_t>(runs));
-    std::atomic<int> next{0};
-    std::mutex err_mutex;
-    auto worker = [&] {
-      for (int i = next++; i < runs; i = next++) {
-        try {
-          results[static_cast<size_t>(i)] = fly(s, config, seed + static_cast<uint64_t>(i), files);
-        } catch (const std::exception& e) {
-          std::lock_guard lk(err_mutex);
-          std::fprintf(stderr, "aerie-bench-landing: run with seed %llu failed: %s\n",
-                       static_cast<unsigned long long>(seed + static_cast<uint64_t>(i)), e.what());
-          ++failures;
-        }
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int j = 0; j < jobs; ++j) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    const auto results = bench::run_seeded<landing::RunResult>(
+        runs, jobs, seed, "aerie-bench-landing", [&](uint64_t run_seed) { return fly(s, config, run_seed, files); }, failures);
     for (size_t i = 0; i < results.size(); ++i) {
       const auto& r = results[i];
       if (r.sim_s <= 0) continue;  // the run failed (said above)
@@ -224,11 +206,5 @@ int main(int argc, char** argv) {
     if (!flown.empty()) std::printf("%s\n", summary(s, flown).c_str());
     std::fflush(stdout);
   }
-  if (plots) {
-    const std::string cmd = "/usr/bin/python3 bench/landing/plot_landing.py " + out_dir;
-    if (std::filesystem::exists("bench/landing/plot_landing.py") && std::system(cmd.c_str()) != 0)
-      std::fprintf(stderr, "aerie-bench-landing: plotting failed (%s)\n", cmd.c_str());
-  }
-  if (failures) std::fprintf(stderr, "aerie-bench-landing: %d runs failed (no row for them)\n", failures);
-  return failures ? 1 : 0;
+  return bench::finish("aerie-bench-landing", "bench/landing/plot_landing.py", out_dir, plots, failures);
 }

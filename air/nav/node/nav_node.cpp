@@ -82,7 +82,12 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
 
 void NavNode::refused(const std::string& what, const std::string& why) {
   last_error_ = what + ": " + why;
-  spdlog::warn("{}", last_error_);
+  // Every refusal is counted; the log shows the 1st, 10th, 100th, ... per channel, so that a
+  // stream of them (VO poses before the alignment, a broken IMU) does not flood it.
+  const int64_t n = ++refusals_[what];
+  int64_t p = 1;
+  while (p < n) p *= 10;
+  if (p == n) spdlog::warn("{} ({} refused on {} so far)", last_error_, n, what);
 }
 
 void NavNode::publish() {

@@ -37,6 +37,7 @@ class NavNode {
   NavNodeOptions opt_;
   Eskf eskf_;
   std::map<std::string, int64_t> counters_;
+  std::map<std::string, int64_t> refusals_;  // per channel, for the log's throttle
   std::string last_error_;
   NavStatus last_status_ = NavStatus::Initialising;
   int64_t seq_ = 0;

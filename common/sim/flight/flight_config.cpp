@@ -73,7 +73,8 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
       .finish();
   using W = WindParams;
   util::SectionReader<W>(cfg.section("wind"), f.wind)("mean_m_s", &W::mean_m_s)("gust_std_m_s", &W::gust_std_m_s)(
-      "gust_time_constant_s", &W::gust_time_constant_s)
+      "gust_time_constant_s", &W::gust_time_constant_s)("yaw_gust_std_per_speed", &W::yaw_gust_std_per_speed)(
+      "yaw_gust_time_constant_s", &W::yaw_gust_time_constant_s)
       .finish();
   using V = VibrationParams;
   util::SectionReader<V>(cfg.section("vibration"), f.vibration)("enabled", &V::enabled)(
@@ -83,7 +84,8 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
   util::SectionReader<P>(cfg.section("placement"), f.placement)("pad_yaw_deg", &P::pad_yaw_deg)(
       "start_distance_min_m", &P::start_distance_min_m)("start_distance_max_m", &P::start_distance_max_m)(
       "start_yaw_deg", &P::start_yaw_deg)("clearance_radius_m", &P::clearance_radius_m)(
-      "exposure_jitter", &P::exposure_jitter)
+      "exposure_jitter", &P::exposure_jitter)("start_x_m", &P::start_x_m)("start_y_m", &P::start_y_m)(
+      "start_height_m", &P::start_height_m)
       .finish();
   f.validate();
   return f;

@@ -43,6 +43,12 @@ void FlightSimConfig::validate() const {
   need(std::abs(ratio - std::round(ratio)) < 1e-9, "imu.rate_hz must be a whole multiple of frame_rate_hz");
   need(wind.mean_m_s >= 0 && wind.mean_m_s <= 15, "wind.mean_m_s must be in [0, 15]");
   need(wind.gust_time_constant_s > 0, "wind.gust_time_constant_s must be > 0");
+  need(wind.yaw_gust_std_per_speed >= 0 && wind.yaw_gust_std_per_speed <= 50,
+       "wind.yaw_gust_std_per_speed must be in [0, 50] (deg/s per m/s)");
+  need(wind.yaw_gust_time_constant_s > 0, "wind.yaw_gust_time_constant_s must be > 0");
+  need(std::isnan(placement.start_x_m) == std::isnan(placement.start_y_m),
+       "placement: give both start_x_m and start_y_m, or neither");
+  need(placement.start_height_m >= 0 && placement.start_height_m <= 50, "placement.start_height_m must be in [0, 50]");
   need(vibration.amplitude_deg >= 0 && vibration.amplitude_deg <= 10, "vibration.amplitude_deg must be in [0, 10]");
   need(vibration.frequency_hz > 0, "vibration.frequency_hz must be > 0");
   need(placement.start_distance_min_m >= 0 && placement.start_distance_max_m >= placement.start_distance_min_m,
@@ -70,27 +76,37 @@ World FlightSim::draw_world(int layout) {
   return World::make(w);
 }
 
+bool FlightSim::column_free(const Eigen::Vector3d& p) const {
+  // On the ground, not on an object; the column it climbs (or starts in) clear; nothing within
+  // clearance_radius_m of the column at the take-off height (room to search).
+  const double r = cfg_.vehicle.radius_m;
+  const double top = std::max(cfg_.vehicle.takeoff_height_m, cfg_.placement.start_height_m);
+  bool free = p.z() <= world_.bounds().min.z() + 1e-9;
+  for (double h = 0.2; free && h <= top + 0.3; h += 0.1)
+    free = world_.signed_distance(p + Eigen::Vector3d(0, 0, r + h)) > r + 0.15;
+  const double z = p.z() + top + r;
+  for (double rad = 0.5; free && rad <= cfg_.placement.clearance_radius_m + 1e-9; rad += 0.5)
+    for (int k = 0; free && k < 16; ++k)
+      free = world_.signed_distance({p.x() + rad * std::cos(k * kPi / 8), p.y() + rad * std::sin(k * kPi / 8), z}) > r + 0.2;
+  return free;
+}
+
 std::optional<Eigen::Vector3d> FlightSim::takeoff_point() {
-  // On free ground at the drawn distance from the pad, with room to climb and to search.
+  if (cfg_.placement.given_start()) {
+    Eigen::Vector3d p(cfg_.placement.start_x_m, cfg_.placement.start_y_m, 10.0);
+    p.z() = support_height(p);
+    return column_free(p) ? std::optional(p) : std::nullopt;
+  }
+  // On free ground at the drawn distance from the pad.
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const Helipad& pad = world_.helipad();
-  const double r = cfg_.vehicle.radius_m;
   for (int attempt = 0; attempt < 500; ++attempt) {
     const double d = cfg_.placement.start_distance_min_m +
                      (cfg_.placement.start_distance_max_m - cfg_.placement.start_distance_min_m) * u01(rng_);
     const double phi = 2 * kPi * u01(rng_);
     Eigen::Vector3d p(pad.center.x() + d * std::cos(phi), pad.center.y() + d * std::sin(phi), 10.0);
     p.z() = support_height(p);
-    bool free = p.z() <= world_.bounds().min.z() + 1e-9;  // on the ground, not on an object
-    for (double h = 0.2; free && h <= cfg_.vehicle.takeoff_height_m + 0.3; h += 0.1)  // the column it climbs
-      free = world_.signed_distance(p + Eigen::Vector3d(0, 0, r + h)) > r + 0.15;
-    // Nothing within clearance_radius_m of the column at the take-off height.
-    const double z = p.z() + cfg_.vehicle.takeoff_height_m + r;
-    for (double rad = 0.5; free && rad <= cfg_.placement.clearance_radius_m + 1e-9; rad += 0.5)
-      for (int k = 0; free && k < 16; ++k)
-        free = world_.signed_distance({p.x() + rad * std::cos(k * kPi / 8), p.y() + rad * std::sin(k * kPi / 8), z}) >
-               r + 0.2;
-    if (free) return p;
+    if (column_free(p)) return p;
   }
   return std::nullopt;
 }
@@ -109,6 +125,11 @@ FlightSim::FlightSim(const FlightSimConfig& config)
     world_ = draw_world(layout);
     start_point = takeoff_point();
   }
+  if (!start_point && cfg_.placement.given_start())
+    throw std::invalid_argument("flight simulator: the given start (" + std::to_string(cfg_.placement.start_x_m) + ", " +
+                                std::to_string(cfg_.placement.start_y_m) + ") is not free ground with " +
+                                "clearance_radius_m around it in " + std::to_string(kLayouts) +
+                                " layouts; move it or lower n_obstacles");
   if (!start_point)
     throw std::invalid_argument("flight simulator: no free take-off point between " +
                                 std::to_string(cfg_.placement.start_distance_min_m) + " and " +
@@ -140,6 +161,12 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   MultirotorState start;
   start.position = *start_point;
   start.yaw = cfg_.placement.start_yaw_deg < 1e9 ? cfg_.placement.start_yaw_deg * kDeg : 2 * kPi * u01(rng_) - kPi;
+  if (cfg_.placement.start_height_m > 0) {  // already flying: armed, holding its place
+    start.position.z() += cfg_.placement.start_height_m;
+    start.armed = true;
+    start.on_ground = false;
+    airborne_ = true;
+  }
   vehicle_ = Multirotor(cfg_.vehicle, start, mix_seed(cfg_.seed, 7006));
   q_prev_ = start.pose().rotation();
 
@@ -148,6 +175,7 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   wind_mean_ = cfg_.wind.mean_m_s * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
   gust_ = cfg_.wind.gust_std() * Eigen::Vector3d(n01(rng_), n01(rng_), 0.0);
   for (auto& axis : vib_phase_) axis = {2 * kPi * u01(rng_), 2 * kPi * u01(rng_), 0.85, 1.15};
+  yaw_gust_rng_.seed(mix_seed(cfg_.seed, 7007));
 }
 
 void FlightSim::set_start_utime(int64_t utime) {
@@ -175,6 +203,15 @@ Eigen::Vector3d FlightSim::wind_step(double dt) {
   gust_.x() = a * gust_.x() + k * n01(rng_);
   gust_.y() = a * gust_.y() + k * n01(rng_);
   return wind_mean_ + gust_;
+}
+
+double FlightSim::yaw_gust_step(double dt) {
+  // First-order Gauss-Markov, exact discretisation; its std grows with the horizontal speed.
+  if (cfg_.wind.yaw_gust_std_per_speed <= 0) return 0.0;
+  const double std = cfg_.wind.yaw_gust_std_per_speed * vehicle_.state().velocity.head<2>().norm();
+  const double a = std::exp(-dt / cfg_.wind.yaw_gust_time_constant_s);
+  yaw_gust_deg_s_ = a * yaw_gust_deg_s_ + std::sqrt(1 - a * a) * std * std::normal_distribution<double>(0.0, 1.0)(yaw_gust_rng_);
+  return yaw_gust_deg_s_;
 }
 
 geometry::SE3 FlightSim::vibration(double t) const {
@@ -227,7 +264,7 @@ void FlightSim::physics_step(double dt) {
   if (outcome_.collided || outcome_.landed) return;
   const Eigen::Vector3d wind = wind_step(dt);
   const double vz_before = vehicle_.state().velocity.z();
-  vehicle_.step(t_, dt, wind);
+  vehicle_.step(t_, dt, wind, yaw_gust_step(dt));
   const auto& s = vehicle_.state();
   const double z_support = support_height(s.position);
   if (s.position.z() <= z_support) {

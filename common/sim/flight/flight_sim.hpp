@@ -30,6 +30,10 @@ struct WindParams {
   double mean_m_s = 0.0;             // steady wind speed (direction drawn from the seed)
   double gust_std_m_s = -1.0;        // gust standard deviation per horizontal axis; < 0: 0.3 * mean
   double gust_time_constant_s = 2.0; // first-order Gauss-Markov gusts (Dryden-like)
+  // Yaw-rate gusts in forward flight (thesis 5.1.5, as aerie-ceopt's scenario): first-order
+  // Gauss-Markov, standard deviation growing with the horizontal speed; 0 = none.
+  double yaw_gust_std_per_speed = 0.0;    // (deg/s) per (m/s)
+  double yaw_gust_time_constant_s = 0.5;
   double gust_std() const { return gust_std_m_s < 0 ? 0.3 * mean_m_s : gust_std_m_s; }
 };
 
@@ -44,6 +48,10 @@ struct PlacementParams {
   double start_distance_min_m = 1.0;  // take-off point's horizontal distance from the pad
   double start_distance_max_m = 2.5;
   double start_yaw_deg = 1e9;      // >= 1e9: drawn from the seed
+  // A given start instead of a drawn one (both finite: x, y of the world); the column must be free.
+  double start_x_m = std::nan(""), start_y_m = std::nan("");
+  double start_height_m = 0.0;     // > 0: start armed, hovering this high above the ground (no take-off)
+  bool given_start() const { return !std::isnan(start_x_m); }
   double clearance_radius_m = 2.0; // nothing within this of the take-off column at take-off height (room to search)
   double exposure_jitter = 0.15;   // lighting: camera exposure drawn in [1 - j, 1 + j]
 };
@@ -162,8 +170,10 @@ class FlightSim {
  private:
   World draw_world(int layout);
   std::optional<Eigen::Vector3d> takeoff_point();
+  bool column_free(const Eigen::Vector3d& p) const;
   void physics_step(double dt);
   Eigen::Vector3d wind_step(double dt);
+  double yaw_gust_step(double dt);
   geometry::SE3 vibration(double t) const;
   double support_height(const Eigen::Vector3d& p) const;
 
@@ -176,6 +186,8 @@ class FlightSim {
   std::mt19937_64 rng_;
   geometry::SE3 T_body_down_, T_body_left_;
   Eigen::Vector3d wind_mean_ = Eigen::Vector3d::Zero(), gust_ = Eigen::Vector3d::Zero();
+  std::mt19937_64 yaw_gust_rng_;   // its own stream: enabling yaw gusts leaves every other draw as it was
+  double yaw_gust_deg_s_ = 0.0;
   std::array<std::array<double, 4>, 3> vib_phase_{};  // per axis: two phases, two frequency factors
   double t_ = 0;
   int64_t frame_ = -1;

@@ -77,7 +77,7 @@ void Multirotor::command(double t_s, const AutopilotCommand& cmd) {
   pending_.emplace_back(t_s + p_.base.command_delay_s, cmd);
 }
 
-void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
+void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind, double yaw_disturbance_deg_s) {
   if (!(dt > 0)) throw std::invalid_argument("Multirotor::step: dt must be > 0");
   while (!pending_.empty() && pending_.front().first <= t_s + 1e-9) {
     const bool holds = active_.mode != AutopilotCommand::Mode::Velocity;
@@ -153,7 +153,7 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind) {
   s_.position += s_.velocity * dt;
 
   s_.yaw_rate = lag(s_.yaw_rate, yaw_rate_cmd, dt, p_.base.yaw_time_constant_s);
-  s_.yaw = std::remainder(s_.yaw + s_.yaw_rate * dt, 2 * std::numbers::pi);
+  s_.yaw = std::remainder(s_.yaw + (s_.yaw_rate - yaw_disturbance_deg_s * kDeg) * dt, 2 * std::numbers::pi);
 
   // Attitude: body z along the thrust's specific force f = a - g - drag, expressed in the
   // heading frame: f ~ (cos(roll) sin(pitch), -sin(roll), cos(roll) cos(pitch)) for ZYX Euler.

@@ -78,8 +78,10 @@ class Multirotor {
   // Queues a command issued at time t_s; it acts from t_s + command latency on.
   void command(double t_s, const AutopilotCommand& cmd);
   // Advances by dt (s) to time t_s + dt with the given wind (world, m/s). Ground contact
-  // is handled by the caller through set_contact() (it owns the world's geometry).
-  void step(double t_s, double dt, const Eigen::Vector3d& wind);
+  // is handled by the caller through set_contact() (it owns the world's geometry). An
+  // external yaw-rate disturbance (deg/s, clockwise positive, e.g. gusts) adds to the
+  // yaw loop's rate, as in the heading model (vehicle.hpp).
+  void step(double t_s, double dt, const Eigen::Vector3d& wind, double yaw_disturbance_deg_s = 0.0);
   // The vehicle rests on a surface at height z_surface: vertical motion stops, and
   // horizontal motion and tilt too when disarmed.
   void set_contact(double z_surface);

@@ -31,6 +31,24 @@ CameraView look_at_wall(const Scene& scene, const CameraParams& camera, double /
   return v;
 }
 
+void SettlingStats::add(double ta, double e, double dt) {
+  itse_ += ta * e * e * dt;
+  iae_ += std::abs(e) * dt;
+  sq_sum_ += e * e * dt;
+  time_ += dt;
+  if (std::abs(e) > band_) {
+    settle_time_ = ta + dt;
+    sq_settle_ = sq_sum_;
+    t_settle_ = time_;
+  }
+}
+
+double SettlingStats::settle_time_s() const { return time_ - t_settle_ > 1e-9 && settle_time_ >= 0.0 ? settle_time_ : -1.0; }
+
+double SettlingStats::steady_rmse_deg() const {
+  return settle_time_s() >= 0.0 ? std::sqrt((sq_sum_ - sq_settle_) / (time_ - t_settle_)) : -1.0;
+}
+
 AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& control, uint64_t seed) {
   if (!(cfg.speed_m_s > 0.0)) throw std::invalid_argument("avoidance: speed must be positive");
   if (!(cfg.sensor.rate_hz > 0.0) || cfg.physics_substeps < 1 || cfg.sensor.delay_s < 0.0)
@@ -59,7 +77,7 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
 
   AvoidanceResult res;
   double applied = 0.0, last_command = 0.0, measured = 0.0;
-  double sq_sum = 0.0, sq_time = 0.0, sq_settle = 0.0, t_settle = 0.0;  // error^2 integrals over the active phase
+  SettlingStats settling(cfg.settle_band_deg);  // over the active phase
   const long max_steps = std::lround(cfg.max_time_s / dt);
   for (long k = 0;; ++k) {
     const double t = k * dt;
@@ -70,21 +88,7 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
     if (s.y >= cfg.scene.dangerous_from()) res.entered_dangerous = true;
 
     // Heading error and its integrals over the active phase (true heading).
-    if (res.activated) {
-      const double e = wrap180(res.reference_deg - s.heading_deg);
-      const double ta = t - res.activation_time_s;
-      res.itse += ta * e * e * dt;
-      res.iae += std::abs(e) * dt;
-      // Settling: the last time the error is outside the band (the usual settling
-      // time); the steady state is what follows it.
-      sq_sum += e * e * dt;
-      sq_time += dt;
-      if (std::abs(e) > cfg.settle_band_deg) {
-        res.settle_time_s = ta + dt;
-        sq_settle = sq_sum;
-        t_settle = sq_time;
-      }
-    }
+    if (res.activated) settling.add(t - res.activation_time_s, wrap180(res.reference_deg - s.heading_deg), dt);
     // End of the run.
     if (s.y >= cfg.scene.wall_y_m) res.collided = true;
     if (std::abs(s.x) >= cfg.scene.lateral_limit_m) res.completed = true;
@@ -121,10 +125,10 @@ AvoidanceResult run_avoidance(const AvoidanceConfig& cfg, const HeadingControl& 
     vehicle.step(applied, cfg.speed_m_s, gust);
   }
   res.min_wall_distance_m = cfg.scene.wall_y_m - res.max_y_m;
-  if (sq_time - t_settle > 1e-9 && res.settle_time_s >= 0.0)
-    res.steady_rmse_deg = std::sqrt((sq_sum - sq_settle) / (sq_time - t_settle));
-  else
-    res.settle_time_s = -1.0;  // never within the band, or only at the very end
+  res.itse = settling.itse();
+  res.iae = settling.iae();
+  res.settle_time_s = settling.settle_time_s();
+  res.steady_rmse_deg = settling.steady_rmse_deg();
   return res;
 }
 

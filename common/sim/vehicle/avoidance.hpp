@@ -94,6 +94,26 @@ struct AvoidanceResult {
   std::vector<AvoidanceSample> trajectory;
 };
 
+// Settling and steady-state error of a heading response (thesis 5.1.6), from samples of the
+// true heading error after the avoidance started: the settling time is the last time |error|
+// is outside the band; the steady state is what follows it. Also the ITSE and IAE integrals.
+class SettlingStats {
+ public:
+  explicit SettlingStats(double band_deg) : band_(band_deg) {}
+  // The error (deg) at t_since_activation (s), held over the next dt (s).
+  void add(double t_since_activation, double error_deg, double dt);
+  double itse() const { return itse_; }
+  double iae() const { return iae_; }
+  // -1 when the error never entered the band for good, or only at the very end.
+  double settle_time_s() const;
+  double steady_rmse_deg() const;
+
+ private:
+  double band_;
+  double itse_ = 0.0, iae_ = 0.0;
+  double sq_sum_ = 0.0, time_ = 0.0, sq_settle_ = 0.0, t_settle_ = 0.0, settle_time_ = -1.0;
+};
+
 // The heading controller under test: called at each heading estimate with its time
 // (s), the estimate (deg) and the reference (deg); returns a yaw-rate command (deg/s).
 // Called only once the avoidance is active; a fresh controller per run.

@@ -13,6 +13,18 @@ void require_known_keys(const util::Config& section, std::initializer_list<const
   section.check_keys(open);
 }
 
+Scene scene_from(const util::Config& scene, Scene c) {
+  require_known_keys(scene, {"wall_m", "normal_area_m", "safe_area_m", "lateral_limit_m"});
+  c.wall_y_m = scene.get("wall_m", c.wall_y_m);
+  c.normal_area_m = scene.get("normal_area_m", c.normal_area_m);
+  c.safe_area_m = scene.get("safe_area_m", c.safe_area_m);
+  c.lateral_limit_m = scene.get("lateral_limit_m", c.lateral_limit_m);
+  if (!(c.normal_area_m > 0 && c.safe_area_m > 0 && c.dangerous_from() < c.wall_y_m && c.lateral_limit_m > 0))
+    throw std::runtime_error(scene.origin() + ": needs 0 < normal_area_m, 0 < safe_area_m, normal + safe < wall_m and "
+                             "0 < lateral_limit_m");
+  return c;
+}
+
 AvoidanceConfig avoidance_config_from(const util::Config& s, AvoidanceConfig c) {
   require_known_keys(s, {"vehicle", "vehicle_params", "scene", "sensor", "camera", "gusts", "physics_substeps", "max_time_s",
                          "settle_band_deg"});
@@ -28,14 +40,7 @@ AvoidanceConfig avoidance_config_from(const util::Config& s, AvoidanceConfig c) 
   c.vehicle.velocity_time_constant_s = vp.get("velocity_time_constant_s", c.vehicle.velocity_time_constant_s);
   c.vehicle.command_delay_s = vp.get("command_delay_s", c.vehicle.command_delay_s);
 
-  const auto scene = s.section("scene");
-  require_known_keys(scene, {"wall_m", "normal_area_m", "safe_area_m", "lateral_limit_m"});
-  c.scene.wall_y_m = scene.get("wall_m", c.scene.wall_y_m);
-  c.scene.normal_area_m = scene.get("normal_area_m", c.scene.normal_area_m);
-  c.scene.safe_area_m = scene.get("safe_area_m", c.scene.safe_area_m);
-  c.scene.lateral_limit_m = scene.get("lateral_limit_m", c.scene.lateral_limit_m);
-  if (!(c.scene.normal_area_m > 0 && c.scene.safe_area_m > 0 && c.scene.dangerous_from() < c.scene.wall_y_m))
-    throw std::runtime_error(scene.origin() + ": needs 0 < normal_area_m, 0 < safe_area_m and normal + safe < wall_m");
+  c.scene = scene_from(s.section("scene"), c.scene);
 
   const auto sensor = s.section("sensor");
   require_known_keys(sensor, {"rate_hz", "delay_s", "noise_std_deg", "drift_deg_per_sqrt_s"});

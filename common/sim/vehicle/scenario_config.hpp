@@ -7,6 +7,9 @@
 
 namespace aerie::sim {
 
+// The `scene:` keys (wall_m, normal_area_m, safe_area_m, lateral_limit_m).
+Scene scene_from(const util::Config& scene, Scene defaults = {});
+
 AvoidanceConfig avoidance_config_from(const util::Config& section, AvoidanceConfig defaults = {});
 
 // Throws std::runtime_error naming the unknown key of `section` and the allowed ones.

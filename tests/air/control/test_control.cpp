@@ -414,3 +414,102 @@ TEST(ControlNode, A25SecondCameraOutageHoversReportsStaleAndRecovers) {
   EXPECT_EQ(s.status.counter("VO_POSE.time_resyncs"), 1);
   EXPECT_EQ(s.status.counter("pose_out_of_order"), 0);
 }
+
+TEST(ControlLoop, FliesStraightUntilTheActivationDistanceThenTurns) {
+  // Thesis 5.1.2: the normal flight area (1 m) is flown straight at zero yaw rate; the turn to
+  // the reference starts once the pose has moved that far from the first one.
+  ControlConfig cfg;
+  cfg.forward_speed_m_s = 0.5;
+  cfg.activation_distance_m = 1.0;
+  cfg.limits.max_yaw_rate_deg_s = 40.0;
+  ControlLoop loop(tuned(), cfg);
+  int64_t t = 1'000'000;
+  for (int k = 0; k < 20; ++k, t += 50'000) {  // 0.95 m in 20 steps of 5 cm, heading 10 deg
+    ASSERT_TRUE(loop.on_heading(t, 10.0, t, Eigen::Vector3d(0.3, 0.05 * k, 2.0)));
+    const Command c = loop.command(t);
+    EXPECT_EQ(c.mode, Mode::kActive);
+    EXPECT_EQ(c.yaw_rate_deg_s, 0.0) << k;
+    EXPECT_EQ(c.forward_speed_m_s, 0.5);
+    EXPECT_DOUBLE_EQ(c.reference_deg, 100.0);  // known from the first heading on
+    EXPECT_DOUBLE_EQ(c.error_deg, 90.0);
+    EXPECT_FALSE(loop.turning());
+  }
+  ASSERT_TRUE(loop.on_heading(t, 10.0, t, Eigen::Vector3d(0.3, 1.0, 2.0)));  // 1 m from the first pose
+  EXPECT_TRUE(loop.turning());
+  EXPECT_DOUBLE_EQ(loop.command(t).yaw_rate_deg_s, 40.0);  // 90 deg of error, saturated
+  // A non-finite position is refused like a non-finite heading.
+  EXPECT_FALSE(loop.on_heading(t + 50'000, 10.0, t, Eigen::Vector3d(NAN, 0, 0)));
+  ControlConfig bad = cfg;
+  bad.activation_distance_m = -1;
+  EXPECT_THROW(ControlLoop(tuned(), bad), std::invalid_argument);
+}
+
+TEST(HeadingFromPose, NavStateBodyAxisAndConfiguredAxis) {
+  // NAV_STATE: a z-up world, the body's x forward, zero heading along world x; yaw is ENU
+  // (counter-clockwise), the heading clockwise.
+  const HeadingFrame nav = default_heading_frame(NodeOptions::Input::kNavState);
+  double q[4];
+  for (double yaw : {0.0, 30.0, -120.0}) {
+    quaternion(Eigen::Quaterniond(Eigen::AngleAxisd(yaw * M_PI / 180, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY())),  // pitched: same heading
+               q);
+    EXPECT_NEAR(heading_from_quaternion(q, nav), -yaw, 1e-9) << yaw;
+  }
+  HeadingFrame zero = nav;
+  zero.axis = Eigen::Vector3d::Zero();
+  EXPECT_THROW(zero.validate(), std::invalid_argument);
+  EXPECT_EQ(default_pose_channel(NodeOptions::Input::kNavState), "NAV_STATE");
+  // The config: input nav, its defaults and an axis override; a misspelt input is refused.
+  const auto setup = node_setup(util::Config::parse("input: nav\nheading_frame:\n  axis: [0, 1, 0]\n", "c.yaml"));
+  EXPECT_EQ(setup.options.pose_channel, "NAV_STATE");
+  EXPECT_EQ(setup.options.frame.up, Eigen::Vector3d(0, 0, 1));
+  EXPECT_EQ(setup.options.frame.axis, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(test::refusal([](const std::string& t) { node_setup(util::Config::parse(t, "c.yaml")); }, "input: navv\n"),
+            "c.yaml: 'input' must be vo, nav or gt, not 'navv'");
+}
+
+TEST(ControlNode, NavStateInputOneCommandPerMessage) {
+  // rate_hz 0: every NAV_STATE is answered by one command carrying its utime (lock-step,
+  // replay); INITIALISING and LOST states are counted and answered by hover / fallback.
+  NodeOptions opt;
+  opt.input = NodeOptions::Input::kNavState;
+  opt.frame = default_heading_frame(opt.input);
+  opt.rate_hz = 0;
+  opt.control.forward_speed_m_s = 0.4;
+  opt.control.activation_distance_m = 1.0;
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "control");
+  int64_t now = 0;
+  ControlNode node(bus, status, tuned(), opt, [&now] { return now; });
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  auto state = [](int64_t utime, int8_t status, double x) {
+    aerie::nav_state_t m{};
+    m.utime = utime;
+    m.status = status;
+    m.orientation[0] = 1;
+    m.position[0] = x;
+    return m;
+  };
+  bus.publish("NAV_STATE", state(0, aerie::nav_state_t::INITIALISING, 0));
+  for (int k = 1; k <= 30; ++k) {
+    now = k * 5'000;
+    bus.publish("NAV_STATE", state(now, k == 15 ? aerie::nav_state_t::IMU_ONLY : aerie::nav_state_t::OK, 0.04 * k));
+  }
+  drain(bus);
+  node.tick(10'000'000);  // no timer at rate 0
+  drain(bus);
+  ASSERT_EQ(cmds.size(), 31u);
+  EXPECT_EQ(cmds[0].mode, aerie::control_cmd_t::HOVER);
+  EXPECT_EQ(status.counter("nav_not_ok"), 1);
+  EXPECT_EQ(status.counter("poses"), 30);  // IMU_ONLY is flown on
+  for (int k = 1; k <= 30; ++k) {
+    EXPECT_EQ(cmds[k].mode, aerie::control_cmd_t::ACTIVE);
+    EXPECT_EQ(cmds[k].utime, k * 5'000);
+    EXPECT_FLOAT_EQ(cmds[k].velocity_body[0], 0.4f);
+    // Straight until 1 m from the first pose (x = 0.04 at k = 1; 1 m at k = 26), then turning.
+    if (k < 26) EXPECT_EQ(cmds[k].yaw_rate_deg_s, 0.0f) << k;
+    else EXPECT_GT(cmds[k].yaw_rate_deg_s, 10.0f) << k;
+  }
+  EXPECT_TRUE(node.loop().turning());
+}

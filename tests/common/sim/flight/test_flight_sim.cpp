@@ -207,3 +207,38 @@ TEST(FlightSimConfig, UnknownKeysAndBadValuesAreNamed) {
   }
   EXPECT_THROW(load("vehicle: {class: blimp}\n"), std::invalid_argument);
 }
+
+TEST(FlightSim, AGivenStartHoversWhereItSaysAndYawGustsTurnItOnlyInForwardFlight) {
+  FlightSimConfig cfg = small_room();
+  cfg.placement.start_x_m = -2.0;
+  cfg.placement.start_y_m = 1.0;
+  cfg.placement.start_yaw_deg = 90;
+  cfg.placement.start_height_m = 1.5;
+  cfg.placement.clearance_radius_m = 0;
+  cfg.wind.yaw_gust_std_per_speed = 3.0;
+  FlightSim sim(cfg);
+  FlightFrame f = fly_until(sim, 2.0);  // no command: the autopilot holds where it started
+  EXPECT_TRUE(f.vehicle.armed);
+  EXPECT_NEAR(f.vehicle.position.x(), -2.0, 0.05);
+  EXPECT_NEAR(f.vehicle.position.y(), 1.0, 0.05);
+  EXPECT_NEAR(f.vehicle.position.z(), 1.5, 0.02);
+  EXPECT_NEAR(f.vehicle.yaw * 180 / std::numbers::pi, 90.0, 0.02);  // gusts scale with the speed: ~none at rest
+  // At rest the IMU reads gravity: still enough for an alignment.
+  for (const auto& s : f.imu) EXPECT_NEAR(s.accel.norm(), 9.81, 0.1);
+  sim.command(mode(kActive, 0.6));
+  double turned = 0;  // by the gusts alone: no yaw rate is commanded
+  while (sim.time() < 6.0) turned = std::max(turned, std::abs(sim.step().vehicle.yaw * 180 / std::numbers::pi - 90.0));
+  EXPECT_GT(turned, 0.5);
+  EXPECT_FALSE(sim.outcome().ended());
+
+  // A start inside an obstacle or a wall is refused naming the start.
+  cfg.placement.start_x_m = 50.0;
+  try {
+    FlightSim bad(cfg);
+    FAIL() << "accepted a start outside the room";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the given start (50.0"), std::string::npos) << e.what();
+  }
+  cfg.placement.start_y_m = std::nan("");
+  EXPECT_THROW(FlightSim{cfg}, std::invalid_argument);  // x without y
+}
