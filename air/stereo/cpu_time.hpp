@@ -12,6 +12,13 @@ inline double cpu_ms() {
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
+// CPU time of the whole process, every thread (the bundle adjuster's, OpenCV's pool).
+inline double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 class CpuStopwatch {
  public:
   CpuStopwatch() : t0_(cpu_ms()) {}

@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 SOURCES = ["gt", "vo", "vio"]
-STYLE = {"gt": "k-", "vo": "C1--", "vio": "C0-"}
+STYLE = {"gt": ("k", "-"), "vo": ("C1", "--"), "vio": ("C0", "-")}  # colour, line
 
 
 def rows(path):
@@ -75,8 +75,8 @@ def main(d):
                 if rm:
                     pts.append((v, statistics.mean(rm), statistics.stdev(rm) if len(rm) > 1 else 0))
             if pts:
-                ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] for p in pts], fmt=STYLE[s][:-1] + "o-",
-                            capsize=3, label=s)
+                ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] for p in pts], color=STYLE[s][0], ls=STYLE[s][1],
+                            marker="o", capsize=3, label=s)
         ax.set_title(f"controller {c}, vibration {shown}")
         ax.set_xlabel("forward speed (m/s)")
         ax.grid(alpha=0.3)
@@ -95,9 +95,11 @@ def main(d):
             turning = [r for r in pts if r["turning"] == "1"]
             if turning:
                 t0 = float(turning[0]["t_s"])
-                ax.plot([float(r["t_s"]) - t0 for r in turning], [float(r["heading_deg"]) for r in turning], STYLE[s], label=s)
+                ax.plot([float(r["t_s"]) - t0 for r in turning], [float(r["heading_deg"]) for r in turning],
+                        color=STYLE[s][0], ls=STYLE[s][1], label=s)
             if pts:
-                ax2.plot([float(r["lateral_m"]) for r in pts], [float(r["travel_m"]) for r in pts], STYLE[s], label=s)
+                ax2.plot([float(r["lateral_m"]) for r in pts], [float(r["travel_m"]) for r in pts], color=STYLE[s][0],
+                         ls=STYLE[s][1], label=s)
         ax.axhline(90, color="grey", lw=0.8)
         ax.set_title(f"{c0}, {v:.1f} m/s, seed {first}")
         ax.set_xlabel("time since the turn started (s)")
