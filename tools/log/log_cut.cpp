@@ -2,12 +2,20 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
+#include <regex>
 #include <stdexcept>
 
 namespace aerie::logtools {
 
 CutResult cut(const std::string& in_path, double from_s, double to_s, const std::string& out_path, bool resync,
-              bool force) {
+              bool force, const std::string& exclude) {
+  std::optional<std::regex> excluded;
+  try {
+    if (!exclude.empty()) excluded.emplace(exclude);
+  } catch (const std::regex_error& e) {
+    throw std::invalid_argument("cut: --exclude '" + exclude + "' is not a regular expression: " + e.what());
+  }
   if (!(from_s >= 0) || !(to_s > from_s))
     throw std::invalid_argument("cut: need 0 <= --from < --to (got " + std::to_string(from_s) + ", " +
                                 std::to_string(to_s) + ")");
@@ -27,7 +35,7 @@ CutResult cut(const std::string& in_path, double from_s, double to_s, const std:
   while (reader.next(ev)) {
     if (r.events_read++ == 0) t0 = ev.utime;
     const int64_t t = ev.utime - t0;
-    if (t >= from_us && t < to_us) writer.write(ev);
+    if (t >= from_us && t < to_us && !(excluded && std::regex_match(ev.channel, *excluded))) writer.write(ev);
   }
   writer.close();
   r.events_written = writer.events_written();

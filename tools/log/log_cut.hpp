@@ -16,10 +16,12 @@ struct CutResult {
   std::vector<logio::Damage> damage;
 };
 
-// Keeps events with from_s <= (utime - first utime) / 1e6 < to_s. Throws
+// Keeps events with from_s <= (utime - first utime) / 1e6 < to_s, except those whose channel
+// matches `exclude` as a whole (ECMAScript regex; "" = none: e.g. a replay leaves out what the
+// nodes it feeds will publish again). Throws std::invalid_argument for a bad regex too. Throws
 // std::invalid_argument for an empty range or an existing output (unless `force`: recorded
 // data is never overwritten by mistake) and std::runtime_error naming the file on I/O errors.
 CutResult cut(const std::string& in_path, double from_s, double to_s, const std::string& out_path,
-              bool resync = false, bool force = false);
+              bool resync = false, bool force = false, const std::string& exclude = "");
 
 }  // namespace aerie::logtools

@@ -1,7 +1,7 @@
 // aerie-log: inspect, export, cut and compare LCM event logs (the lcm-logger format).
 //   aerie-log info LOG [--json] [--resync]
 //   aerie-log export LOG --channel C --out DIR [--resync] [--force]
-//   aerie-log cut LOG --from S --to S --out LOG2 [--resync] [--force]
+//   aerie-log cut LOG --from S --to S --out LOG2 [--exclude REGEX] [--resync] [--force]
 //   aerie-log diff A B [--channels C1,C2,...]
 // Exit status: 0 ok, 1 error (bad arguments, missing file/channel), 2 the log is
 // damaged (everything before the damage was still processed, and it is reported).
@@ -29,7 +29,7 @@ int report_damage(const std::vector<aerie::logio::Damage>& damage) {
 int main(int argc, char** argv) {
   CLI::App app{"Inspect, export, cut and compare LCM event logs (lcm-logger format)", "aerie-log"};
   app.require_subcommand(1);
-  std::string log, log_b, channel, out;
+  std::string log, log_b, channel, out, exclude;
   std::vector<std::string> channels;
   bool json = false, resync = false, force = false;
   double from_s = 0, to_s = std::numeric_limits<double>::infinity();
@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   cut->add_option("--from", from_s, "Start, seconds from the first event (inclusive)")->check(CLI::NonNegativeNumber);
   cut->add_option("--to", to_s, "End, seconds from the first event (exclusive; default: the end)");
   cut->add_option("--out", out, "Output log file")->required();
+  cut->add_option("--exclude", exclude, "Leave out the channels matching this regular expression (whole name, ECMAScript)");
 
   auto* diff = app.add_subcommand("diff", "Compare two logs channel by channel: counts, identical messages, the "
                                            "largest numeric field difference");
@@ -107,7 +108,7 @@ int main(int argc, char** argv) {
       if (r.other_type) std::cout << "skipped " << r.other_type << " messages of another type\n";
       return report_damage(r.damage);
     }
-    const auto r = aerie::logtools::cut(log, from_s, to_s, out, resync, force);
+    const auto r = aerie::logtools::cut(log, from_s, to_s, out, resync, force, exclude);
     std::cout << "wrote " << r.events_written << " of " << r.events_read << " events to " << out << "\n";
     return report_damage(r.damage);
   } catch (const std::exception& e) {

@@ -1,6 +1,8 @@
 // aerie-vo: stereo visual odometry node. CAM_STEREO (rectified pairs) -> VO_POSE, VO_DEPTH,
 // STATUS_VO. See docs/stereo.md and config/vo.yaml.
 #include <opencv2/core/utility.hpp>
+
+#include <algorithm>
 #include <spdlog/spdlog.h>
 
 #include "air/stereo/node/vo_node.hpp"
@@ -12,11 +14,14 @@ int main(int argc, char** argv) {
   aerie::util::CommonOptions common;
   aerie::util::add_common_options(app, common);
   std::string input, pose, depth;
-  bool no_ba = false;
+  bool no_ba = false, replay = false;
   app.add_option("--input", input, "stereo channel (default from config: CAM_STEREO)");
   app.add_option("--pose-channel", pose, "pose channel (default VO_POSE)");
   app.add_option("--depth-channel", depth, "spherical depth channel (default VO_DEPTH; \"none\" turns it off)");
   app.add_flag("--no-ba", no_ba, "run without the keyframe bundle adjustment");
+  app.add_flag("--replay", replay,
+               "replaying a log: process every pair, whatever the speed, with the same result every time "
+               "(the bundle adjustment synchronous, the input queue 1000 pairs instead of node.queue)");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("vo", common.log_level);
   // The front end is one thread by design (the bundle adjuster has its own): OpenCV's pool
@@ -30,11 +35,15 @@ int main(int argc, char** argv) {
     if (!pose.empty()) cfg.pose = pose;
     if (!depth.empty()) cfg.depth = depth == "none" ? "" : depth;
     if (no_ba) cfg.vo.ba.enabled = false;
-    cfg.vo.ba_synchronous = false;  // a node never waits for the bundle adjustment
+    // Live, a node never waits for the bundle adjustment (its result lands at whichever frame
+    // is current when it finishes); a replay waits, so that the result depends on the data alone.
+    cfg.vo.ba_synchronous = replay;
+    if (replay) cfg.queue = std::max(cfg.queue, 1000);
     aerie::bus::Bus bus(common.lcm_url);
     aerie::bus::StatusReporter status(bus, "VO");
     aerie::stereo::VoNode node(bus, status, cfg);
-    spdlog::info("{} -> {}{}", cfg.input, cfg.pose, cfg.depth.empty() ? "" : ", " + cfg.depth);
+    spdlog::info("{} -> {}{}{}", cfg.input, cfg.pose, cfg.depth.empty() ? "" : ", " + cfg.depth,
+                 replay ? " (replay: every pair, bundle adjustment synchronous)" : "");
     aerie::bus::run(bus, status, [&] {
       node.tick();  // reports the camera stale during an outage
       return true;

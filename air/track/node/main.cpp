@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   aerie::util::CommonOptions common;
   aerie::util::add_common_options(app, common);
   std::string camera, tracker;
-  bool stereo = false;
+  bool stereo = false, replay = false;
   int init_from_gt = -1;
   double target_size = -1;
   app.add_option("--camera", camera, "camera channel (default from the config, else CAM_LEFT)");
@@ -22,6 +22,8 @@ int main(int argc, char** argv) {
   app.add_option("--init-from-gt", init_from_gt,
                  "initialise on the GT_TRACK box after this many frames (simulation demo, no operator)");
   app.add_option("--target-size", target_size, "target width = height in metres (enables TARGET_POSE)");
+  app.add_flag("--replay", replay,
+               "replaying a log: track every frame in order, whatever the speed (instead of the newest frame)");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("track", common.log_level);
 
@@ -35,6 +37,7 @@ int main(int argc, char** argv) {
       opt.tracker = tracker;
     }
     if (init_from_gt >= 0) opt.init_from_gt = init_from_gt;
+    opt.every_frame = replay;
     if (target_size > 0) opt.target.width_m = opt.target.height_m = target_size;
 
     aerie::bus::Bus bus(common.lcm_url);

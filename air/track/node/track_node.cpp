@@ -123,6 +123,7 @@ TrackNode::TrackNode(bus::Bus& bus, NodeOptions options, util::NodeClock now)
     if (!(opt_.reseed_iou >= 0 && opt_.reseed_iou <= 1)) throw std::invalid_argument("target.reseed_iou must be in [0, 1]");
   }
   tracker_params_ = opt_.trackers.section(opt_.tracker);
+  const int camera_queue = opt_.every_frame ? 1000 : 30;
   if (opt_.stereo) {
     bus_.subscribe<aerie::stereo_image_t>(opt_.camera_channel, [this](const aerie::stereo_image_t& m,
                                                                       const bus::ReceiveInfo& info) {
@@ -131,7 +132,7 @@ TrackNode::TrackNode(bus::Bus& bus, NodeOptions options, util::NodeClock now)
       c.height = m.left.height;
       c.fx = m.fx, c.fy = m.fy, c.cx = m.cx, c.cy = m.cy;
       on_frame({m.left, info.recv_utime, c});
-    });
+    }, camera_queue);
   } else {
     bus_.subscribe<aerie::image_t>(opt_.camera_channel, [this](const aerie::image_t& m, const bus::ReceiveInfo& info) {
       std::optional<camera::CameraModel> cam;
@@ -142,7 +143,7 @@ TrackNode::TrackNode(bus::Bus& bus, NodeOptions options, util::NodeClock now)
         fail(opt_.camera_channel + ": " + e.what() + " (configured camera kept)");
       }
       on_frame({m, info.recv_utime, cam});
-    });
+    }, camera_queue);
   }
   bus_.subscribe<aerie::track_cmd_t>(opt_.command_channel,
                                      [this](const aerie::track_cmd_t& m, const bus::ReceiveInfo&) { on_command(m); });
@@ -157,11 +158,13 @@ TrackNode::~TrackNode() {
     stop_ = true;
   }
   wake_.notify_all();
+  taken_.notify_all();
   worker_.join();
 }
 
 void TrackNode::on_frame(Frame frame) {
-  std::lock_guard lk(mutex_);
+  std::unique_lock lk(mutex_);
+  if (opt_.every_frame) taken_.wait(lk, [&] { return !pending_ || stop_; });
   ++counters_["frames_received"];
   // The message-time policy, reported under the names bus::InputClock uses.
   const auto time = camera_clock_.observe(frame.image.utime, now_());
@@ -255,6 +258,7 @@ void TrackNode::run() {
       frame.swap(pending_);
       busy_ = true;
     }
+    taken_.notify_all();
     bool initialised_now = false;
     if (frame) {
       try {
@@ -297,8 +301,10 @@ void TrackNode::run() {
       std::optional<aerie::gt_box_t> gt;
       {
         std::lock_guard lk(mutex_);
-        for (const auto& g : gt_)  // the box of this frame, else the newest one before it
-          if (g.visible && g.utime <= frame->image.utime && (!gt || g.utime >= gt->utime)) gt = g;
+        // The box of this very frame (same utime), never an older one: which box initialises
+        // the tracker must not depend on how the channels' messages interleaved (replays).
+        for (const auto& g : gt_)
+          if (g.visible && g.utime == frame->image.utime) gt = g;
       }
       if (gt) {
         try {

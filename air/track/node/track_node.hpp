@@ -53,6 +53,9 @@ struct NodeOptions {
   util::Config trackers;  // per-tracker parameter sections (track.yaml "trackers:")
   int max_points = 200;   // sample positions per level published for display
   int init_from_gt = -1;  // >= 0: after this many frames, initialise on the GT_TRACK box
+  // Replaying a log: every frame is tracked, in order (the LCM thread waits for the worker,
+  // the camera queue holds 1000 frames) instead of the newest one.
+  bool every_frame = false;
   std::string target_name = "target";
   TargetGeometry target;  // width/height 0: no TARGET_POSE
   TargetShape target_shape = TargetShape::Box;
@@ -110,7 +113,7 @@ class TrackNode {
 
   // Shared between the LCM thread and the worker.
   mutable std::mutex mutex_;
-  std::condition_variable wake_, idle_;
+  std::condition_variable wake_, idle_, taken_;  // taken_: the worker took the pending frame
   std::optional<Frame> pending_;
   std::deque<aerie::track_cmd_t> commands_;
   std::map<std::string, int64_t> counters_;

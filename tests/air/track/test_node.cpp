@@ -115,6 +115,52 @@ TEST_F(NodeTest, InitThenTracksEveryFrameWithTheSourceUtime) {
   EXPECT_EQ(node.counter("frames_processed") + node.counter("frames_skipped") + 1, node.counter("frames_received"));
 }
 
+// Replay (--replay): frames delivered faster than the tracker runs are all tracked, in order,
+// with the same boxes as when they come one at a time.
+TEST_F(NodeTest, EveryFrameModeTracksABurstInOrderAsOneAtATime) {
+  auto fly = [&](bool burst) {
+    aerie::bus::Bus bus("memq://");  // one bus per node: a node's subscriptions live as long as its bus
+    std::vector<aerie::track_t> tracks;
+    bus.subscribe<aerie::track_t>("TRACK", [&](const aerie::track_t& m, const aerie::bus::ReceiveInfo&) { tracks.push_back(m); });
+    NodeOptions opt;
+    opt.every_frame = true;
+    TrackNode node(bus, opt);
+    auto settle_bus = [&] {
+      for (int round = 0; round < 3; ++round) {
+        while (bus.handle(0) > 0) {
+        }
+        EXPECT_TRUE(node.wait_idle(5000));
+      }
+      while (bus.handle(0) > 0) {
+      }
+    };
+    bus.publish("CAM_LEFT", frame(0));
+    settle_bus();
+    aerie::track_cmd_t c{};
+    c.command = aerie::track_cmd_t::INIT;
+    c.tracker = "amcmr-ct";
+    const cv::Rect2d box = scene_.box(motion(0));
+    c.x = box.x, c.y = box.y, c.width = box.width, c.height = box.height;
+    bus.publish("TRACK_CMD", c);
+    settle_bus();
+    for (int i = 1; i <= 40; ++i) {
+      bus.publish("CAM_LEFT", frame(i));
+      if (!burst) settle_bus();
+    }
+    settle_bus();
+    EXPECT_EQ(node.counter("frames_skipped"), 0);
+    return tracks;
+  };
+  const auto paced = fly(false), burst = fly(true);
+  ASSERT_EQ(paced.size(), 41u);
+  ASSERT_EQ(burst.size(), 41u);
+  for (size_t k = 0; k < burst.size(); ++k) {
+    EXPECT_EQ(burst[k].utime, 1'000'000 + 33'333 * static_cast<int64_t>(k));
+    EXPECT_EQ(burst[k].x, paced[k].x) << k;
+    EXPECT_EQ(burst[k].y, paced[k].y) << k;
+  }
+}
+
 // The correlation-filter tracker chosen by an INIT command, with its own parameter.
 TEST_F(NodeTest, DcfChosenByTheInitCommand) {
   TrackNode node(bus_, NodeOptions{});

@@ -259,6 +259,29 @@ TEST(LogCut, TimeRangeFromTheStart) {
   EXPECT_THROW(cut(log, 0, 1, log), std::invalid_argument);
 }
 
+TEST(LogCut, ExcludesTheChannelsAReplayWillPublishAgain) {
+  const auto dir = test::scratch_dir("log");
+  const auto log = make_log(dir).string();
+  const auto out = (dir / "cut.lcm").string();
+  const auto all = summarize(log);
+  const auto r = cut(log, 0, std::numeric_limits<double>::infinity(), out, false, false, "GT_.*|CAM_STEREO");
+  const auto s = summarize(out);
+  for (const auto& c : all.channels) {
+    const bool gone = c.channel.starts_with("GT_") || c.channel == "CAM_STEREO";
+    const bool kept = std::any_of(s.channels.begin(), s.channels.end(), [&](const auto& k) { return k.channel == c.channel; });
+    EXPECT_EQ(kept, !gone) << c.channel;
+    if (kept) EXPECT_EQ(channel(s, c.channel).count, c.count) << c.channel;
+  }
+  EXPECT_GT(r.events_written, 0);
+  EXPECT_LT(r.events_written, r.events_read);
+  try {
+    cut(log, 0, 1, (dir / "x.lcm").string(), false, false, "GT_(");
+    FAIL() << "accepted a bad regular expression";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--exclude 'GT_(' is not a regular expression"), std::string::npos) << e.what();
+  }
+}
+
 TEST(LogCut, RefusesToOverwriteAnExistingOutputWithoutForce) {
   const auto dir = test::scratch_dir("log");
   const auto log = make_log(dir).string();
