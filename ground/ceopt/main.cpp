@@ -155,8 +155,8 @@ int main(int argc, char** argv) {
                    cfg.evaluation.runs_per_speed);
       in.runs = run_experiment(in.controllers, cfg, pool);
       for (const auto& s : summarise(in.runs))
-        spdlog::info("  {:8s} {:.1f} m/s: RMSE {:.2f} ± {:.2f} deg ({} settled), min wall distance {:.2f} m, {} in dangerous area",
-                     s.controller, s.speed, s.rmse_mean, s.rmse_std, s.settled, s.min_wall_distance, s.entered_dangerous);
+        spdlog::info("  {:8s} {:.1f} m/s: steady-state RMSE (deg) {} ({} of {} settled), min wall distance {:.2f} m, {} in dangerous area",
+                     s.controller, s.speed, rmse_text(s), s.settled, s.runs, s.min_wall_distance, s.entered_dangerous);
     }
     const auto files = write_report(out, in);
     spdlog::info("wrote {} files to {}", files.size(), out);

@@ -214,8 +214,7 @@ std::vector<std::string> write_report(const std::string& dir_name, const ReportI
           if (s.controller == "sf") thesis = f(th.sf, 2);
           if (s.controller == "sfmf") thesis = f(th.sfmf, 2);
         }
-      const std::string rmse = s.settled ? f(s.rmse_mean, 2) + " ± " + f(s.rmse_std, 2) : "never settled";
-      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << rmse << " | "
+      w << "| " << s.controller << " | " << f(s.speed, 1) << " | " << rmse_text(s) << " | "
         << thesis << " | " << f(s.min_wall_distance, 2) << " | " << s.entered_dangerous << "/" << s.runs << " | " << s.collided
         << " | " << s.settled << "/" << s.runs << " |\n";
     }
@@ -242,6 +241,10 @@ bool draw_plots(const std::string& dir, const std::string& script, std::string* 
   const int rc = pclose(p);
   if (rc != 0 && error) *error = "plot script failed (" + std::to_string(rc) + "): " + out;
   return rc == 0;
+}
+
+std::string rmse_text(const ExperimentSummary& s) {
+  return s.settled > 0 ? f(s.rmse_mean, 2) + " ± " + f(s.rmse_std, 2) : "never settled";
 }
 
 }  // namespace aerie::ceopt

@@ -27,5 +27,7 @@ std::vector<std::string> write_report(const std::string& dir, const ReportInputs
 bool draw_plots(const std::string& dir, const std::string& script, std::string* error);
 
 std::string read_loadavg();
+// "1.16 ± 0.16" (deg) over the settled runs, or "never settled" when none did (no NaN).
+std::string rmse_text(const ExperimentSummary& s);
 
 }  // namespace aerie::ceopt

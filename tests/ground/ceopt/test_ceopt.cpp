@@ -11,6 +11,7 @@
 #include "ground/ceopt/cross_entropy.hpp"
 #include "ground/ceopt/flc_problem.hpp"
 #include "ground/ceopt/pipeline.hpp"
+#include "ground/ceopt/report.hpp"
 #include "ground/ceopt/thread_pool.hpp"
 
 using namespace aerie;
@@ -236,4 +237,17 @@ TEST(Pipeline, ShortTuningImprovesOnTheInitialControllerAndIsReproducible) {
   const auto sum = summarise(runs);
   ASSERT_EQ(sum.size(), 3u);
   EXPECT_EQ(sum[0].runs, 2);
+}
+
+TEST(CeoptReport, AnExperimentWithNoSettledRunSaysSoInsteadOfNan) {
+  // Issue 18: the hand-tuned initial FLC never settles; the summary printed "RMSE nan ± nan".
+  ExperimentSummary s;
+  s.controller = "initial";
+  s.runs = 20;
+  s.rmse_mean = s.rmse_std = std::nan("");
+  EXPECT_EQ(rmse_text(s), "never settled");
+  s.settled = 20;
+  s.rmse_mean = 1.156;
+  s.rmse_std = 0.164;
+  EXPECT_EQ(rmse_text(s), "1.16 ± 0.16");
 }
