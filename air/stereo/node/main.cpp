@@ -20,8 +20,8 @@ int main(int argc, char** argv) {
   app.add_option("--depth-channel", depth, "spherical depth channel (default VO_DEPTH; \"none\" turns it off)");
   app.add_flag("--no-ba", no_ba, "run without the keyframe bundle adjustment");
   app.add_flag("--replay", replay,
-               "replaying a log: process every pair, whatever the speed, with the same result every time "
-               "(the bundle adjustment synchronous, the input queue 1000 pairs instead of node.queue)");
+               "replaying a log: process every pair, whatever the speed (the input queue 1000 pairs instead of "
+               "node.queue); with ba.apply next_keyframe (the default) a replay gives the live poses again");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("vo", common.log_level);
   // The front end is one thread by design (the bundle adjuster has its own): OpenCV's pool
@@ -35,15 +35,15 @@ int main(int argc, char** argv) {
     if (!pose.empty()) cfg.pose = pose;
     if (!depth.empty()) cfg.depth = depth == "none" ? "" : depth;
     if (no_ba) cfg.vo.ba.enabled = false;
-    // Live, a node never waits for the bundle adjustment (its result lands at whichever frame
-    // is current when it finishes); a replay waits, so that the result depends on the data alone.
-    cfg.vo.ba_synchronous = replay;
+    // The node never waits for a bundle adjustment it has just started (ba.synchronous is for
+    // offline evaluation); ba.apply decides where its result lands.
+    cfg.vo.ba_synchronous = false;
     if (replay) cfg.queue = std::max(cfg.queue, 1000);
     aerie::bus::Bus bus(common.lcm_url);
     aerie::bus::StatusReporter status(bus, "VO");
     aerie::stereo::VoNode node(bus, status, cfg);
     spdlog::info("{} -> {}{}{}", cfg.input, cfg.pose, cfg.depth.empty() ? "" : ", " + cfg.depth,
-                 replay ? " (replay: every pair, bundle adjustment synchronous)" : "");
+                 replay ? " (replay: every pair)" : "");
     aerie::bus::run(bus, status, [&] {
       node.tick();  // reports the camera stale during an outage
       return true;

@@ -77,6 +77,7 @@ void StereoOdometry::reset(const std::string& why) {
   // The odometry chain restarts from the pose published last, so the pose does not jump.
   T_odom_cam_ = T_world_cam_;
   anchor_.reset();
+  ba_due_.reset();
   kf_odom_.clear();
   have_kf_ = false;
   restarted_ = true;
@@ -141,6 +142,10 @@ void StereoOdometry::make_keyframe(int64_t utime, const Frame& frame) {
   kf_odom_[kf.id] = T_odom_cam_;
   while (static_cast<int>(kf_odom_.size()) > 4 * params_.ba.window) kf_odom_.erase(kf_odom_.begin());
   if (ba_) {
+    if (params_.ba_next_keyframe && !params_.ba_synchronous) {
+      ba_->wait_idle();         // the previous keyframe's optimisation
+      ba_due_ = ba_->poll();    // applied at this frame, however fast the machine is
+    }
     ba_->add_keyframe(std::move(kf));
     if (params_.ba_synchronous) ba_->wait_idle();
   }
@@ -366,7 +371,12 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
 
   // 7. Re-anchor on the newest bundle-adjusted keyframe: T_world = T_world_K * T_odom_K^-1 * T_odom.
   if (ba_) {
-    if (auto res = ba_->poll()) {
+    std::optional<BaResult> res;
+    if (params_.ba_next_keyframe && !params_.ba_synchronous)
+      res.swap(ba_due_);
+    else
+      res = ba_->poll();
+    if (res) {
       const auto kf = kf_odom_.find(res->keyframe_id);
       if (kf != kf_odom_.end()) {
         anchor_ = std::make_pair(res->T_world_cam, kf->second);

@@ -52,6 +52,10 @@ struct VoParams {
   double keyframe_rotation_deg = 10.0;
   BaParams ba;
   bool ba_synchronous = false;  // wait for each BA (reproducible offline evaluation)
+  // Asynchronous BA: keyframe k's result is applied at keyframe k+1 (waiting for it there if
+  // it is not done), so the trajectory depends on the data alone and a replay reproduces a
+  // live run; false: at whichever frame it is ready (depends on the machine's speed).
+  bool ba_next_keyframe = true;
 
   void validate() const;  // throws std::invalid_argument naming the key
   static SgbmCtfParams default_depth() {
@@ -151,6 +155,7 @@ class StereoOdometry {
   std::map<int64_t, geometry::SE3> kf_odom_;       // keyframe id -> T_odom_cam when it was made
   // The newest bundle-adjusted keyframe: its refined T_world_cam and its odometry pose.
   std::optional<std::pair<geometry::SE3, geometry::SE3>> anchor_;
+  std::optional<BaResult> ba_due_;  // ba_next_keyframe: the previous keyframe's result, applied at this one
   cv::Mat left_half_, right_half_;
 };
 

@@ -95,6 +95,11 @@ VoParams vo_params_from_config(const util::Config& cfg, const std::vector<std::s
   rd("ba.min_observations", p.ba.min_observations);
   rd("ba.max_depth_m", p.ba.max_depth_m);
   rd("ba.synchronous", p.ba_synchronous);
+  std::string apply = p.ba_next_keyframe ? "next_keyframe" : "when_ready";
+  rd("ba.apply", apply);
+  if (apply != "next_keyframe" && apply != "when_ready")
+    throw std::runtime_error(cfg.origin() + ": ba.apply must be next_keyframe or when_ready, not '" + apply + "'");
+  p.ba_next_keyframe = apply == "next_keyframe";
 
   rd.check_unknown(other_sections);
   try {
