@@ -434,7 +434,9 @@ FlcSpec parse_fll(const std::string& text, const std::string& origin) {
     // The triangles must be the Ruspini partition of their peaks (see flc.hpp).
     const int n = static_cast<int>(terms.size());
     if (n < 2) fail(fv.line, "input '" + fv.name + "' needs at least 2 terms");
-    const double tol = 1e-9 * (v.max - v.min);
+    // Up to what printing moved them: 1e-9 of the range, or 1.5e-3 in the file's own (unscaled)
+    // units, three roundings at fuzzylite's default 3 decimals (a foot against two peaks).
+    const double tol = std::max(1e-9 * (v.max - v.min), 1.5e-3 * std::abs(k));
     for (int s = 0; s < n; ++s) {
       const auto& c = v.positions;
       double a = terms[static_cast<size_t>(s)].params[0] * k, e = terms[static_cast<size_t>(s)].params[2] * k;
@@ -469,7 +471,7 @@ FlcSpec parse_fll(const std::string& text, const std::string& origin) {
   // Rules: "if A is X and B is Y and C is Z then O is W [with w]".
   for (const auto& [line, text_rule] : rules) {
     const auto w = words(text_rule);
-    auto bad = [&, line = line](const std::string& why) {
+    auto bad = [&, line = line, &text_rule = text_rule](const std::string& why) {  // init-captures: clang < 16 cannot capture a structured binding
       fail(line, "rule '" + text_rule + "': " + why + " (expected: if <input> is <set> and ... then <output> is <set> [with w])");
     };
     if (w.size() < 8 || w[0] != "if") bad("too short");

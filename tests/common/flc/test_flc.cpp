@@ -337,6 +337,32 @@ TEST(Fll, FuzzyliteComputesTheSameOutputs) {
   for (double e = -20; e <= 20; e += 0.77) EXPECT_NEAR(a.evaluate(e, 3 * e, -e), b.evaluate(e, 3 * e, -e), 1e-9);
 }
 
+TEST(Fll, FuzzylitesDefaultThreeDecimalExportIsAccepted) {
+  // Issue 18: aerie-ceopt's SF+MF controller exported by fuzzylite at its default 3 decimals
+  // was refused (its feet no longer exactly at the neighbours' peaks). Accepted within the
+  // documented tolerance, it computes nearly what the original does.
+  const FlcSpec sfmf = load_yaml((aerie::test::source_dir() / "config" / "flc" / "sfmf.yaml").string());
+  fl::FllImporter importer;
+  std::unique_ptr<fl::Engine> engine(importer.fromString(to_fll(sfmf)));
+  const int decimals = fl::fuzzylite::decimals();
+  fl::fuzzylite::setDecimals(3);
+  const std::string text = fl::FllExporter().toString(engine.get());
+  fl::fuzzylite::setDecimals(decimals);
+  const FlcSpec back = parse_fll(text, "fuzzylite-3-decimals.fll");
+  const Flc a(sfmf), b(back);
+  double worst = 0;
+  for (double e = -90; e <= 90; e += 1.3)
+    for (double d = -20; d <= 20; d += 2.7) worst = std::max(worst, std::abs(a.evaluate(e, d, -e / 9) - b.evaluate(e, d, -e / 9)));
+  EXPECT_LT(worst, 0.5);  // deg/s, of a +-90 deg/s output
+  // Feet farther off than printing explains are still refused.
+  std::string moved = text;
+  const auto at = moved.find("Triangle");
+  ASSERT_NE(at, std::string::npos);
+  const auto num = moved.find_first_of("-0123456789", at);
+  moved.insert(num, "1");  // the first foot of the first term, an order of magnitude off
+  EXPECT_THROW(parse_fll(moved, "moved.fll"), std::runtime_error);
+}
+
 TEST(Prune, ThesisOptimisedControllerReducesTo45Rules) {
   PruneReport rep;
   const FlcSpec p = prune(thesis_optimised(), {}, &rep);
