@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -16,6 +18,8 @@ PmdError::PmdError(const std::string& origin, int line, int column, const std::s
       column_(column) {}
 
 namespace {
+
+constexpr double kMaxStopTimeAllowed = 3600;  // s before SIGKILL (libbot2 sets no bound; this keeps it a finite float)
 
 enum class Tok { Identifier, String, Number, Assign, Semicolon, Open, Close, End };
 
@@ -65,7 +69,7 @@ class Lexer {
       if (c == '-') t.text += advance();
       while (pos_ < s_.size() && (std::isdigit(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '.'))
         t.text += advance();
-      if (t.text == "-" || std::count(t.text.begin(), t.text.end(), '.') > 1)
+      if (t.text.find_first_of("0123456789") == std::string::npos || std::count(t.text.begin(), t.text.end(), '.') > 1)
         throw PmdError(origin_, t.line, t.column, "malformed number '" + t.text + "'");
       return t;
     }
@@ -194,13 +198,15 @@ class Parser {
         }
       } else if (key.text == "stop_signal" || key.text == "stop_time_allowed") {
         const Token v = expect(Tok::Number, "a number for '" + key.text + "'");
-        const double x = std::stod(v.text);
+        const double x = std::strtod(v.text.c_str(), nullptr);  // [-]digits[.digits]; inf when too long
         if (key.text == "stop_signal") {
-          if (x != static_cast<int>(x) || x < 1 || x > 64)
+          if (!(x >= 1 && x <= 64) || x != std::floor(x))
             fail(v, "stop_signal must be a signal number 1..64, found " + v.text);
           c.stop_signal = static_cast<int>(x);
         } else {
-          if (!(x > 0)) fail(v, "stop_time_allowed must be positive (seconds), found " + v.text);
+          if (!(x > 0 && x <= kMaxStopTimeAllowed))
+            fail(v, "stop_time_allowed must be in (0, " + std::to_string(static_cast<int>(kMaxStopTimeAllowed)) +
+                        "] seconds, found " + v.text);
           c.stop_time_allowed_s = x;
         }
       } else {
@@ -275,7 +281,8 @@ class Parser {
           act.kind = ActionKind::WaitMs;
           const Token n = expect(Tok::Number, "a duration in milliseconds");
           if (n.text.find_first_of(".-") != std::string::npos) fail(n, "wait ms needs a non-negative integer");
-          act.wait_ms = std::stoll(n.text);
+          if (std::from_chars(n.text.data(), n.text.data() + n.text.size(), act.wait_ms).ec != std::errc())
+            fail(n, "wait ms " + n.text + " is out of range");
         } else if (what.text == "cmd" || what.text == "group") {
           act.kind = ActionKind::WaitStatus;
           act.target = what.text == "group" ? TargetKind::Group : TargetKind::Command;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -63,13 +64,17 @@ std::vector<std::string> list_images(const std::string& dir) {
 }
 
 std::optional<int64_t> parse_seconds(const std::string& text) {
+  // Times whose microseconds do not fit in int64 (e.g. EuRoC's nanosecond stamps given as seconds).
+  constexpr int64_t kMaxSeconds = (std::numeric_limits<int64_t>::max() - 1'000'000) / 1'000'000;
   size_t i = 0;
   const bool neg = !text.empty() && text[0] == '-';
   if (neg) ++i;
   int64_t whole = 0;
   size_t digits = 0;
-  for (; i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])); ++i, ++digits)
+  for (; i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])); ++i, ++digits) {
     whole = whole * 10 + (text[i] - '0');
+    if (whole > kMaxSeconds) return std::nullopt;
+  }
   int64_t frac = 0;
   int frac_digits = 0;
   bool round_up = false;
@@ -89,6 +94,7 @@ std::optional<int64_t> parse_seconds(const std::string& text) {
     double x = 0;
     const auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), x);
     if (ec != std::errc() || p != text.data() + text.size()) return std::nullopt;
+    if (!(std::abs(x) <= static_cast<double>(kMaxSeconds))) return std::nullopt;  // also NaN, inf
     return static_cast<int64_t>(std::llround(x * 1e6));
   }
   for (int k = std::min(frac_digits, 6); k < 6; ++k) frac *= 10;

@@ -17,7 +17,8 @@ namespace aerie::capture {
 std::vector<std::string> list_images(const std::string& dir);
 
 // Decimal seconds to microseconds without floating-point rounding ("1403715273.262143" ->
-// 1403715273262143; more than 6 decimals are rounded half up). nullopt if not a number.
+// 1403715273262143; more than 6 decimals are rounded half up). nullopt if not a number or
+// beyond what int64 microseconds hold.
 std::optional<int64_t> parse_seconds(const std::string& text);
 
 // One time per line, seconds (first token; '#' comment lines and blank lines skipped).

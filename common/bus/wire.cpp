@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 
 namespace aerie::bus {
@@ -124,7 +125,13 @@ class Walker {
     if (len == 0) refuse(w, what + " lacks the NUL terminator it counts");
     if (len - 1 > w.field->cap) refuse(w, what + " exceeds the cap " + std::to_string(w.field->cap));
     if (static_cast<uint64_t>(len) > left_) refuse(w, what + " exceeds the " + std::to_string(left_) + " bytes left");
-    if (take(w, static_cast<size_t>(len))[len - 1] != 0) refuse(w, what + " does not end with NUL");
+    const uint8_t* text = take(w, static_cast<size_t>(len));
+    if (text[len - 1] != 0) refuse(w, what + " does not end with NUL");
+    // lcm-gen encodes strlen() bytes but sizes the message by std::string::size(): a decoded NUL
+    // inside would make any re-encoding (aerie-link's JPEG re-encoding keeps image metadata)
+    // shorter than its size, padded with bytes every receiver refuses (uninitialised ones through
+    // lcm::LCM::publish(channel, &msg)).
+    if (std::memchr(text, 0, static_cast<size_t>(len - 1))) refuse(w, what + " holds a NUL before its end");
   }
 
   const uint8_t* p_;

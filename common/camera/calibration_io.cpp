@@ -135,7 +135,9 @@ StereoCalibration read_kitti_stereo(const std::string& calib_txt, int width, int
   return s;
 }
 
-StereoCalibration read_opencv_stereo(const std::string& yaml) {
+namespace {
+
+StereoCalibration read_opencv_stereo_fields(const std::string& yaml) {
   cv::FileStorage fsr;
   try {
     fsr.open(yaml, cv::FileStorage::READ);
@@ -148,6 +150,15 @@ StereoCalibration read_opencv_stereo(const std::string& yaml) {
     if (n.empty()) fail(yaml, std::string("missing field '") + key + "'");
     return n;
   };
+  // OpenCV allocates the rows x cols a matrix node declares before it reads the data (a corrupt
+  // `cols` asked for 48 GB): the size is checked first; a calibration matrix has at most 9 numbers.
+  auto matrix = [&](const cv::FileNode& n, const std::string& key) {
+    const double elements = n["rows"].real() * n["cols"].real();
+    if (!(elements >= 0 && elements <= 64)) fail(yaml, "field '" + key + "' is not a small matrix");
+    cv::Mat m;
+    n >> m;
+    return m;
+  };
   StereoCalibration s;
   s.source = yaml;
   const int w = static_cast<int>(need("width"));
@@ -156,8 +167,7 @@ StereoCalibration read_opencv_stereo(const std::string& yaml) {
     CameraModel c;
     c.width = w;
     c.height = h;
-    cv::Mat K, D;
-    need((side + "_K").c_str()) >> K;
+    cv::Mat K = matrix(need((side + "_K").c_str()), side + "_K");
     if (K.rows != 3 || K.cols != 3) fail(yaml, "field '" + side + "_K' must be a 3x3 matrix");
     K.convertTo(K, CV_64F);
     c.fx = K.at<double>(0, 0);
@@ -168,7 +178,7 @@ StereoCalibration read_opencv_stereo(const std::string& yaml) {
     if (!fsr[side + "_model"].empty()) fsr[side + "_model"] >> model;
     c.distortion = distortion_from_string(model);
     if (!fsr[side + "_D"].empty()) {
-      fsr[side + "_D"] >> D;
+      cv::Mat D = matrix(fsr[side + "_D"], side + "_D");
       D.convertTo(D, CV_64F);
       c.coeffs.assign(D.begin<double>(), D.end<double>());
     }
@@ -176,9 +186,8 @@ StereoCalibration read_opencv_stereo(const std::string& yaml) {
   };
   s.left = camera("left");
   s.right = camera("right");
-  cv::Mat R, T;
-  need("R") >> R;
-  need("T") >> T;
+  cv::Mat R = matrix(need("R"), "R");
+  cv::Mat T = matrix(need("T"), "T");
   if (R.rows != 3 || R.cols != 3) fail(yaml, "field 'R' must be a 3x3 matrix");
   if (T.total() != 3) fail(yaml, "field 'T' must hold 3 numbers");
   R.convertTo(R, CV_64F);
@@ -188,6 +197,21 @@ StereoCalibration read_opencv_stereo(const std::string& yaml) {
   s.T_right_left = geometry::SE3(Re, Eigen::Vector3d(T.at<double>(0), T.at<double>(1), T.at<double>(2)));
   s.validate();
   return s;
+}
+
+}  // namespace
+
+StereoCalibration read_opencv_stereo(const std::string& yaml) {
+  // FileStorage throws cv::Exception on malformed content (a matrix without data or with a
+  // mistyped key, a list where a map belongs), and its parser lets std::length_error out of a
+  // corrupt file: refused like any other bad field.
+  try {
+    return read_opencv_stereo_fields(yaml);
+  } catch (const std::runtime_error&) {
+    throw;  // fail(): names the file and the field
+  } catch (const std::exception& e) {
+    fail(yaml, std::string("cannot read: ") + e.what());
+  }
 }
 
 void write_opencv_stereo(const StereoCalibration& c, const std::string& yaml) {
