@@ -5,12 +5,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
+#include <sstream>
 #include <stdexcept>
 
 #include "ground/map/key_ray.hpp"
@@ -502,8 +505,73 @@ void check_tree(const octomap::OcTree& tree, std::istream& in, const char* what)
 }
 }  // namespace
 
-std::unique_ptr<octomap::OcTree> read_octree(std::istream& in, bool binary) {
+namespace {
+// OctoMap's readers recurse once per tree level without a depth limit and read on after their
+// stream has failed: a crafted tree overflows the stack or, truncated, grows without end (issue
+// 19, fuzz/regressions/octomap). So the body is walked here first, iteratively: at most 16
+// levels (OctoMap's tree depth), every byte present, at most kMaxMapNodes nodes.
+// Throws std::invalid_argument naming what is wrong.
+void check_octree_body(const std::string& bytes, bool binary) {
+  // The header: lines up to "data" (OctoMap's AbstractOcTree::readHeader); then the body.
+  size_t pos = 0;
+  std::string id;
+  for (int line = 0;; ++line) {
+    const size_t eol = bytes.find('\n', pos);
+    if (eol == std::string::npos || line > 100) throw std::invalid_argument("an OctoMap tree without a 'data' line");
+    const std::string l = bytes.substr(pos, eol - pos);
+    pos = eol + 1;
+    if (l.rfind("id ", 0) == 0) id = l.substr(3);
+    if (l == "data" || l == "data\r") break;
+  }
+  while (!id.empty() && (id.back() == '\r' || id.back() == ' ')) id.pop_back();
+  if (id != "OcTree") throw std::invalid_argument("a tree of id '" + id + "', not an OcTree");
+  if (pos == bytes.size()) return;  // an empty tree
+  // .bt: 2 bytes per node, 2 bits per child (01 free leaf, 10 occupied leaf, 11 inner node).
+  // .ot: per node a float and a byte of child flags; every child is a node of its own.
+  const size_t node_bytes = binary ? 2 : sizeof(float) + 1;
+  std::vector<int> pending;  // per level: children still to read
+  size_t nodes = 1;
+  auto read_node = [&](size_t depth) {
+    if (pos + node_bytes > bytes.size())
+      throw std::invalid_argument("an OctoMap tree cut short (" + std::to_string(bytes.size()) + " bytes)");
+    int children = 0, inner = 0;
+    if (binary) {
+      for (int b = 0; b < 2; ++b) {
+        const auto flags = static_cast<uint8_t>(bytes[pos + static_cast<size_t>(b)]);
+        for (int i = 0; i < 4; ++i) {
+          const int code = (flags >> (2 * i)) & 3;
+          children += code != 0;
+          inner += code == 3;
+        }
+      }
+    } else {
+      inner = children = std::popcount(static_cast<uint8_t>(bytes[pos + sizeof(float)]));
+    }
+    pos += node_bytes;
+    if (inner > 0 && depth >= 16)
+      throw std::invalid_argument("an OctoMap tree deeper than 16 levels (not a saved map: garbage data?)");
+    nodes += static_cast<size_t>(children);
+    if (nodes > kMaxMapNodes)
+      throw std::invalid_argument("an OctoMap tree of more than " + std::to_string(kMaxMapNodes) + " nodes");
+    pending.push_back(inner);
+  };
+  read_node(0);
+  while (!pending.empty()) {
+    if (pending.back() == 0) {
+      pending.pop_back();
+      continue;
+    }
+    --pending.back();
+    read_node(pending.size());
+  }
+}
+}  // namespace
+
+std::unique_ptr<octomap::OcTree> read_octree(std::istream& stream, bool binary) {
   const QuietCerr quiet;
+  const std::string bytes((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
+  check_octree_body(bytes, binary);
+  std::istringstream in(bytes);
   if (binary) {
     auto tree = std::make_unique<octomap::OcTree>(0.1);  // readBinary sets the resolution it reads
     if (!tree->readBinary(in)) throw std::invalid_argument("not an OctoMap binary (.bt) tree");
