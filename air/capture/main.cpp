@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   option(app, ov, "--timestamps", [](CaptureConfig& c) -> auto& { return c.source.timestamps; },
          "folder: timestamps file, seconds per line");
   option(app, ov, "--groundtruth", [](CaptureConfig& c) -> auto& { return c.source.groundtruth; },
-         "euroc: TUM trajectory of the body when the folder has no state_groundtruth_estimate0");
+         "euroc: TUM trajectory of the body when the folder has no state_groundtruth_estimate0; kitti: the "
+         "poses file (poses/NN.txt; found by itself in KITTI's download layout); refused for other sources");
   option(app, ov, "--fps", [](CaptureConfig& c) -> auto& { return c.source.fps; },
          "Frame rate of sources without timestamps; requested camera rate");
   option(app, ov, "--rate", [](CaptureConfig& c) -> auto& { return c.rate; },

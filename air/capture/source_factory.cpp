@@ -13,6 +13,9 @@ std::unique_ptr<FrameSource> make_source(const SourceOptions& o) {
   auto need_path = [&](const char* what) {
     if (o.path.empty()) throw std::invalid_argument("source '" + o.type + "' needs a path (" + what + ")");
   };
+  if (!o.groundtruth.empty() && o.type != "euroc" && o.type != "kitti")
+    throw std::invalid_argument("source.groundtruth (--groundtruth) applies to euroc and kitti sources, not to '" +
+                                o.type + "'");
   if (o.type == "sim") return std::make_unique<SimSource>(o.sim, o.width, o.height, o.color, o.fps);
   if (o.type == "folder") {
     need_path("image folder");
@@ -24,7 +27,7 @@ std::unique_ptr<FrameSource> make_source(const SourceOptions& o) {
   }
   if (o.type == "kitti") {
     need_path("KITTI odometry folder");
-    return std::make_unique<StereoSequenceSource>(load_kitti(o.path), o.color);
+    return std::make_unique<StereoSequenceSource>(load_kitti(o.path, o.groundtruth), o.color);
   }
   if (o.type == "video") {
     need_path("video file");

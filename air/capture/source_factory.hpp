@@ -24,7 +24,8 @@ struct SourceOptions {
   std::string right;          // v4l2: second device of a stereo pair
   std::string calib;          // v4l2: stereo calibration file/folder
   std::string timestamps;     // folder: timestamps file (seconds per line)
-  std::string groundtruth;    // euroc: TUM body trajectory when the folder has no state_groundtruth_estimate0
+  std::string groundtruth;    // euroc: TUM body trajectory when the folder has no state_groundtruth_estimate0;
+                              // kitti: a poses file (NN.txt); refused for the other sources
   double fps = 20.0;          // folder without timestamps / video without rate / v4l2 request / sim
   int width = 0, height = 0;  // v4l2: requested size; sim: rendered size (0 = default 376x240)
   bool color = false;         // read colour images (gray otherwise)

@@ -88,7 +88,7 @@ StereoSequence load_euroc(const std::string& dir, const std::string& gt_tum) {
   return s;
 }
 
-StereoSequence load_kitti(const std::string& dir) {
+StereoSequence load_kitti(const std::string& dir, const std::string& poses_file) {
   const fs::path root(dir);
   std::error_code ec;
   if (!fs::is_directory(root, ec)) throw std::runtime_error(dir + ": KITTI folder does not exist");
@@ -124,8 +124,16 @@ StereoSequence load_kitti(const std::string& dir) {
   } else {
     for (size_t i = 0; i < n; ++i) s.utimes.push_back(static_cast<int64_t>(i) * 100'000);  // KITTI: 10 Hz
   }
-  const fs::path poses = root / "poses.txt";
-  if (fs::exists(poses)) {
+  fs::path poses = poses_file;
+  if (!poses.empty() && !fs::is_regular_file(poses, ec))
+    throw std::runtime_error(poses.string() + ": KITTI poses file does not exist");
+  if (poses.empty()) poses = root / "poses.txt";
+  // KITTI's download layout: dataset/sequences/NN and dataset/poses/NN.txt.
+  const fs::path canonical = fs::weakly_canonical(root, ec);
+  const fs::path download = canonical.parent_path().parent_path() / "poses" / (canonical.filename().string() + ".txt");
+  if (!fs::exists(poses, ec) && canonical.parent_path().filename() == "sequences" && fs::exists(download, ec))
+    poses = download;
+  if (fs::exists(poses, ec)) {
     const auto p = read_kitti_poses(poses.string());
     if (p.size() < n)
       throw std::runtime_error(poses.string() + ": " + std::to_string(p.size()) + " poses for " + std::to_string(n) +

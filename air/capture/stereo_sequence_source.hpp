@@ -30,8 +30,10 @@ struct StereoSequence {
 StereoSequence load_euroc(const std::string& dir, const std::string& gt_tum = "");
 
 // KITTI odometry folder: image_0/ + image_1/ (or image_l/ + image_r/), calib.txt,
-// optional times.txt (else 10 Hz) and poses.txt (T_0_i of the left camera).
-StereoSequence load_kitti(const std::string& dir);
+// optional times.txt (else 10 Hz) and ground truth (T_0_i of the left camera): `poses_file`
+// when given (it must exist), else the folder's poses.txt, else, in KITTI's download layout
+// (dataset/sequences/NN with dataset/poses/NN.txt), that NN.txt.
+StereoSequence load_kitti(const std::string& dir, const std::string& poses_file = "");
 
 class StereoSequenceSource final : public FrameSource {
  public:

@@ -380,8 +380,33 @@ TEST(SimSource, FramesTimesAndGroundTruth) {
   EXPECT_ERROR_NAMES(SimSource(bad, 0, 0, false, 20), "loop-the-loop");
 }
 
+TEST(KittiSource, DownloadLayoutFindsItsPosesAndAGivenFileIsUsed) {
+  // Issue 18: dataset/sequences/NN with dataset/poses/NN.txt gave frames but no GT_POSE.
+  AERIE_REQUIRE_DATA(kKitti);
+  const auto data = test::shared_data(kKitti);
+  const auto root = test::scratch_dir("kitti_download");
+  const auto seq = root / "dataset" / "sequences" / "06";
+  fs::create_directories(seq);
+  fs::create_directories(root / "dataset" / "poses");
+  for (const char* f : {"image_l", "image_r"}) fs::create_directory_symlink(data / f, seq / f);
+  fs::copy_file(data / "calib.txt", seq / "calib.txt");
+  fs::copy_file(data / "times.txt", seq / "times.txt");
+  EXPECT_TRUE(load_kitti(seq.string()).gt.empty());  // no poses anywhere: frames without truth
+  fs::copy_file(data / "poses.txt", root / "dataset" / "poses" / "06.txt");
+  const auto poses = read_kitti_poses((data / "poses.txt").string());
+  const StereoSequence found = load_kitti(seq.string());
+  ASSERT_EQ(found.gt.size(), 51u);
+  EXPECT_LT((found.gt[50]->translation() - poses[50].translation()).norm(), 1e-12);
+  // An explicit poses file (--groundtruth) wins; a missing one is an error naming it.
+  EXPECT_EQ(load_kitti(seq.string(), (data / "poses.txt").string()).gt.size(), 51u);
+  EXPECT_ERROR_NAMES(load_kitti(seq.string(), (root / "nope.txt").string()), "nope.txt: KITTI poses file does not exist");
+}
+
 TEST(SourceFactory, BadOptionsAreExplained) {
   EXPECT_ERROR_NAMES(make_source(source("lidar")), "unknown source type 'lidar'");
+  SourceOptions folder = source("folder", "/tmp");
+  folder.groundtruth = "poses.txt";  // was silently ignored
+  EXPECT_ERROR_NAMES(make_source(folder), "--groundtruth) applies to euroc and kitti sources, not to 'folder'");
   EXPECT_ERROR_NAMES(make_source(source("kitti")), "needs a path");
   EXPECT_ERROR_NAMES(make_source(source("v4l2", "/dev/video-none")), "/dev/video-none");
 }
