@@ -460,7 +460,7 @@ TEST(MapService, LoadChecksTheFileAndKeepsTheOldMap) {
   const size_t nodes = h.service.map().tree().size();
   const std::vector<std::pair<std::string, std::string>> bad{
       {"res_1e300.bt", "resolution 1000000"}, {"res_1e-300.bt", "resolution 0.000000 m, outside [0.010000"},
-      {"garbage.ot", "log-odds"}, {"trailing.bt", "followed by bytes"}};
+      {"garbage.ot", "garbage data?"}, {"trailing.bt", "followed by bytes"}};  // garbage: too deep or odd log-odds
   int64_t errors = 0;
   for (const auto& [file, why] : bad) {
     command(h, aerie::map_cmd_t::LOAD, file);
