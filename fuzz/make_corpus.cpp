@@ -5,7 +5,7 @@
 // with the project's own encoders, files written by its own writers (controllers, .pmd,
 // calibrations, trajectories, boxes, octrees, logs) and the configs of config/. With --log,
 // short windows of a recorded flight (every channel's first messages; per node, its channels
-// for a second). With --reliability (../shared/reliability/repro), the crafted inputs of the
+// for a second). With --reliability (the shared reliability reproducers, a folder given on the command line), the crafted inputs of the
 // reliability issue: each payload as it is, and on its channel of every node target that
 // subscribes to it. Files are written only when missing or different.
 #include <aerie/flc_params_t.hpp>
@@ -557,7 +557,7 @@ void log_seeds(const std::string& path) {
 // --- the reliability issue's reproducers ----------------------------------------------------
 
 // Which channel of a node target each reproducer goes to, by the start of its file name
-// (../shared/reliability/README.md).
+// (the reliability README beside those reproducers).
 struct Route {
   const char* prefix;
   const char* target;
