@@ -142,7 +142,7 @@ void StereoOdometry::make_keyframe(int64_t utime, const Frame& frame) {
   kf_odom_[kf.id] = T_odom_cam_;
   while (static_cast<int>(kf_odom_.size()) > 4 * params_.ba.window) kf_odom_.erase(kf_odom_.begin());
   if (ba_) {
-    if (params_.ba_next_keyframe && !params_.ba_synchronous) {
+    if (ba_at_next_keyframe()) {
       ba_->wait_idle();         // the previous keyframe's optimisation
       ba_due_ = ba_->poll();    // applied at this frame, however fast the machine is
     }
@@ -372,7 +372,7 @@ VoResult StereoOdometry::run(const cv::Mat& left, const cv::Mat& right, int64_t 
   // 7. Re-anchor on the newest bundle-adjusted keyframe: T_world = T_world_K * T_odom_K^-1 * T_odom.
   if (ba_) {
     std::optional<BaResult> res;
-    if (params_.ba_next_keyframe && !params_.ba_synchronous)
+    if (ba_at_next_keyframe())
       res.swap(ba_due_);
     else
       res = ba_->poll();

@@ -156,6 +156,7 @@ class StereoOdometry {
   // The newest bundle-adjusted keyframe: its refined T_world_cam and its odometry pose.
   std::optional<std::pair<geometry::SE3, geometry::SE3>> anchor_;
   std::optional<BaResult> ba_due_;  // ba_next_keyframe: the previous keyframe's result, applied at this one
+  bool ba_at_next_keyframe() const { return params_.ba_next_keyframe && !params_.ba_synchronous; }
   cv::Mat left_half_, right_half_;
 };
 
