@@ -1,7 +1,6 @@
 #pragma once
 // Seeded closed-loop runs on a few threads, as the lock-step benches fly them: run i has seed
 // `seed + i` and its own slot, so the results do not depend on the number of threads.
-#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -9,8 +8,9 @@
 #include <filesystem>
 #include <string>
 #include <mutex>
-#include <thread>
 #include <vector>
+
+#include "common/util/parallel.hpp"
 
 namespace aerie::bench {
 
@@ -20,23 +20,17 @@ namespace aerie::bench {
 template <class Result, class Fly>
 std::vector<Result> run_seeded(int runs, int jobs, uint64_t seed, const char* tool, Fly fly, int& failures) {
   std::vector<Result> results(static_cast<size_t>(runs));
-  std::atomic<int> next{0};
   std::mutex err_mutex;
-  auto worker = [&] {
-    for (int i = next++; i < runs; i = next++) {
-      const uint64_t s = seed + static_cast<uint64_t>(i);
-      try {
-        results[static_cast<size_t>(i)] = fly(s);
-      } catch (const std::exception& e) {
-        std::lock_guard lk(err_mutex);
-        std::fprintf(stderr, "%s: run with seed %llu failed: %s\n", tool, static_cast<unsigned long long>(s), e.what());
-        ++failures;
-      }
+  util::parallel_for(runs, jobs, [&](int i) {
+    const uint64_t s = seed + static_cast<uint64_t>(i);
+    try {
+      results[static_cast<size_t>(i)] = fly(s);
+    } catch (const std::exception& e) {
+      std::lock_guard lk(err_mutex);
+      std::fprintf(stderr, "%s: run with seed %llu failed: %s\n", tool, static_cast<unsigned long long>(s), e.what());
+      ++failures;
     }
-  };
-  std::vector<std::thread> pool;
-  for (int j = 0; j < jobs; ++j) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+  });
   return results;
 }
 

@@ -23,13 +23,6 @@ using namespace aerie;
 
 namespace {
 
-// "initial": the thesis' initial FLC; a bare name: config/flc/NAME.yaml (sf, sfmf: aerie-ceopt's); else a file.
-flc::FlcSpec controller_named(const std::string& name) {
-  if (name == "initial") return flc::thesis_initial();
-  const bool bare = name.find('/') == std::string::npos && name.find('.') == std::string::npos;
-  return flc::load_controller(bare ? "config/flc/" + name + ".yaml" : name);
-}
-
 struct Setup {
   double speed = 0.6;
   avoidance::Source source = avoidance::Source::kVio;
@@ -98,7 +91,7 @@ int main(int argc, char** argv) {
   std::vector<std::pair<std::string, flc::FlcSpec>> flcs;
   try {
     base = avoidance::load_run_config(util::Config::load(config_file));
-    for (const auto& c : controllers) flcs.emplace_back(c, controller_named(c));
+    for (const auto& c : controllers) flcs.emplace_back(c, avoidance::controller_named(c));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "aerie-bench-avoidance: %s\n", e.what());
     return 2;

@@ -68,8 +68,8 @@ landing::RunResult fly(const Setup& setup, landing::RunConfig rc, uint64_t seed,
     log = std::make_unique<logio::Writer>(log_dir + "/" + setup.tracker + "-" + setup.controller + "-" + setup.world +
                                           "-wind" + std::to_string(static_cast<int>(setup.wind)) + "-vib" +
                                           (setup.vibration ? "on" : "off") + "-seed" + std::to_string(seed) + ".lcm");
-    rc.on_message = [&log](const std::string& channel, const uint8_t* data, size_t size) {
-      log->write(bus::peek_utime(data, size).value_or(0), channel, data, size);
+    rc.on_message = [&log](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
+      log->write(now_us, channel, data, size);
     };
   }
   return landing::fly(rc);

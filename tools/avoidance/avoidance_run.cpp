@@ -65,6 +65,12 @@ RunConfig load_run_config(const util::Config& cfg, const std::string& base_dir) 
   return rc;
 }
 
+flc::FlcSpec controller_named(const std::string& name, const std::string& base_dir) {
+  if (name == "initial") return flc::thesis_initial();
+  const bool bare = name.find('/') == std::string::npos && name.find('.') == std::string::npos;
+  return flc::load_controller(bare ? base_dir + "/config/flc/" + name + ".yaml" : name);
+}
+
 RunResult fly(const RunConfig& config, uint64_t seed) {
   const auto wall0 = std::chrono::steady_clock::now();
   RunResult r;
@@ -82,16 +88,15 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     throw std::invalid_argument("avoidance: the surface ahead of the start is " + (hit ? std::to_string(hit->t) : "none") +
                                 " m away; scene.wall_m is " + std::to_string(config.scene.wall_y_m));
 
-  bus::Bus bus("memq://");
-  if (config.on_message)
-    bus.subscribe_raw(".*", [&](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
-      config.on_message(info.channel, data, size);
-    }, 100000);
+  link::SplitBus buses(config.split);
+  bus::Bus& air = buses.on(link::Side::kAir);
+  buses.tap(config.on_message);
   sim::FlightSimNodeOptions so;
-  so.answer_channels.clear();  // every node below answers on this thread: the bus drained = answered
-  sim::FlightSimNode sim_node(bus, simulator, so);
+  so.answer_channels.clear();  // every node below answers on this thread: the buses settled = answered
+  sim::FlightSimNode sim_node(air, simulator, so);
 
-  bus::StatusReporter vo_status(bus, "vo"), control_status(bus, "control");
+  bus::Bus &vo_bus = buses.of("vo"), &control_bus = buses.of("control");
+  bus::StatusReporter vo_status(vo_bus, "vo"), control_status(control_bus, "control");
   std::unique_ptr<stereo::VoNode> vo_node;
   std::unique_ptr<nav::NavNode> nav_node;
   control::NodeOptions co = config.control;
@@ -111,7 +116,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     stereo::VoNodeConfig vc = config.vo;
     vc.vo.ba_synchronous = true;
     vc.depth = "";
-    vo_node = std::make_unique<stereo::VoNode>(bus, vo_status, vc, now);
+    vo_node = std::make_unique<stereo::VoNode>(vo_bus, vo_status, vc, now);
   }
   if (config.source == Source::kVo) {
     // VO's world is its first left camera frame: the rig's up and forward, seen from the camera
@@ -120,15 +125,15 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     co.frame.up = R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
     co.frame.forward = R_body_cam.transpose() * Eigen::Vector3d::UnitX();
   }
-  if (config.source == Source::kVio) nav_node = std::make_unique<nav::NavNode>(bus, config.nav);
-  control::ControlNode control_node(bus, control_status, config.controller, co, now);
+  if (config.source == Source::kVio) nav_node = std::make_unique<nav::NavNode>(buses.of("nav"), config.nav);
+  control::ControlNode control_node(control_bus, control_status, config.controller, co, now);
 
-  bus.subscribe<aerie::pose_t>(config.vo.pose, [&](const aerie::pose_t& m, const bus::ReceiveInfo&) {
+  vo_bus.subscribe<aerie::pose_t>(config.vo.pose, [&](const aerie::pose_t& m, const bus::ReceiveInfo&) {
     ++r.vo_poses;
     r.vo_not_ok += m.status != aerie::pose_t::OK;
   });
   aerie::control_cmd_t last_cmd{};
-  bus.subscribe<aerie::control_cmd_t>(co.command_channel, [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) {
+  control_bus.subscribe<aerie::control_cmd_t>(co.command_channel, [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) {
     last_cmd = m;
     r.commands_fallback += m.mode == aerie::control_cmd_t::FALLBACK_HOVER;
   });
@@ -140,8 +145,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   int64_t est_n = 0;
   while (true) {
     const sim::FlightFrame& f = sim_node.publish_next();
-    while (bus.handle(0) > 0) {
-    }
+    buses.settle(f.utime);
     Sample s;
     s.t = f.t;
     const Eigen::Vector2d d = f.vehicle.position.head<2>() - start.position.head<2>();
@@ -181,6 +185,8 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   if (nav_node) r.nav_gated = nav_node->filter().counters().vo_gated;
   r.lockstep_timeouts = sim_node.lockstep_timeouts();
   r.commands_refused = simulator.commands_refused();
+  r.link_down = buses.down_counters();
+  r.link_up = buses.up_counters();
   r.sim_s = simulator.time();
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return r;

@@ -11,9 +11,11 @@
 // its own estimate) to fly parallel to the wall, and the flight ends after
 // scene.lateral_limit_m sideways, a collision, or the time limit. Every node handles its
 // messages on the calling thread, so a frame is answered when the bus is empty: a run is a
-// function of its configuration and seed.
+// function of its configuration and seed. With a split, "vo", "nav" and "control" may run on
+// the ground side, behind the link in simulation time (tools/link/sim_link.hpp).
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,7 @@
 #include "common/sim/flight/flight_sim.hpp"
 #include "common/sim/vehicle/avoidance.hpp"
 #include "common/util/config.hpp"
+#include "tools/link/sim_link.hpp"
 
 namespace aerie::avoidance {
 
@@ -41,14 +44,21 @@ struct RunConfig {
   control::NodeOptions control; // input, channel, rate (one command per input) and heading frame are set per source
   stereo::VoNodeConfig vo;      // its bundle adjustment runs synchronously here (reproducible)
   nav::NavConfig nav;
-  // Sees every message on the bus (channel, payload) in bus order, e.g. to record it.
-  std::function<void(const std::string&, const uint8_t*, size_t)> on_message;
+  // Nodes "vo", "nav" and "control" on the ground side, and the link; none: one bus.
+  std::optional<link::Split> split;
+  // Sees every message on each side's bus in bus order, with the simulation time it is
+  // handled at, e.g. to record it (the air side only without a split).
+  link::SplitBus::Tap on_message;
 };
 
 // config/avoidance.yaml: `sim:` (config/sim/landing_room.yaml's keys), `scene:`,
 // `settle_band_deg`, `control:` (stale_timeout_s, limits) and the files of `vo:` and `nav:`
 // (relative paths from base_dir, the repository root). Throws naming the file and key.
 RunConfig load_run_config(const util::Config& cfg, const std::string& base_dir = ".");
+
+// "initial": the thesis' initial FLC; a bare name: config/flc/NAME.yaml under base_dir (sf,
+// sfmf: aerie-ceopt's); else a file. Throws naming the file.
+flc::FlcSpec controller_named(const std::string& name, const std::string& base_dir = ".");
 
 // One frame of the flight (true values unless named estimate).
 struct Sample {
@@ -67,6 +77,7 @@ struct RunResult {
   double min_wall_distance_m = 0;
   double estimate_rmse_deg = std::nan("");  // heading estimate vs truth over the flight
   int64_t vo_poses = 0, vo_not_ok = 0, nav_gated = 0, commands_fallback = 0, lockstep_timeouts = 0, commands_refused = 0;
+  link::DirectionCounters link_down, link_up;  // with a split
   double sim_s = 0, wall_s = 0;
   std::vector<Sample> trajectory;
 };

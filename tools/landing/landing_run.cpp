@@ -33,22 +33,28 @@ int64_t RunResult::box_poses() const {
 RunResult fly(const RunConfig& config) {
   const auto wall0 = std::chrono::steady_clock::now();
   sim::FlightSim simulator(config.sim);
-  bus::Bus bus("memq://");
-  if (config.on_message)
-    bus.subscribe_raw(".*", [&](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
-      config.on_message(info.channel, data, size);
-    }, 100000);
-  sim::FlightSimNode sim_node(bus, simulator, {});
-  track::TrackNode track_node(bus, config.track);
-  pilot::PilotNode pilot_node(bus, config.pilot);
+  link::SplitBus buses(config.split);
+  bus::Bus& air = buses.on(link::Side::kAir);
+  buses.tap(config.on_message);
+  sim::FlightSimNodeOptions so;
+  so.answer_channels.clear();  // a frame is answered when the buses are settled
+  sim::FlightSimNode sim_node(air, simulator, so);
+  track::NodeOptions to = config.track;
+  to.every_frame = true;  // lock-step: every frame delivered is tracked
+  track::TrackNode track_node(buses.of("track"), to);
+  bus::Bus& pilot_bus = buses.of("pilot");
+  pilot::PilotNode pilot_node(pilot_bus, config.pilot);
 
   RunResult r;
   std::map<int64_t, sim::TargetTruth> truth;  // of the last frames, by utime
-  bool descending = false;
-  bus.subscribe<aerie::pilot_state_t>("PILOT_STATE", [&](const aerie::pilot_state_t& m, const bus::ReceiveInfo&) {
+  bool descending = false, holding_stale = false;
+  pilot_bus.subscribe<aerie::pilot_state_t>("PILOT_STATE", [&](const aerie::pilot_state_t& m, const bus::ReceiveInfo&) {
     descending = m.state == aerie::pilot_state_t::DESCEND;
-  });
-  bus.subscribe<aerie::target_pose_t>("TARGET_POSE", [&](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
+    const bool stale = m.state == aerie::pilot_state_t::HOLD && m.reason.find("(stale)") != std::string::npos;
+    r.pilot_stale_holds += stale && !holding_stale;
+    holding_stale = stale;
+  }, 1000);
+  pilot_bus.subscribe<aerie::target_pose_t>("TARGET_POSE", [&](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
     ++r.target_poses;
     const auto it = truth.find(m.utime);
     if (!descending || it == truth.end()) return;
@@ -57,14 +63,14 @@ RunResult fly(const RunConfig& config) {
                          m.position[2] - g.position.z(),
                          std::remainder(m.yaw - g.yaw, std::numbers::pi) * 180 / std::numbers::pi,
                          m.source == aerie::target_pose_t::SOURCE_FIT});
-  });
+  }, 1000);
 
   int64_t end_frame = -1;
   while (true) {
     const sim::FlightFrame& f = sim_node.publish_next();
     truth[f.utime] = f.target;
-    if (truth.size() > 50) truth.erase(truth.begin());
-    sim_node.wait_answers();
+    if (truth.size() > 400) truth.erase(truth.begin());  // 20 s at 20 Hz: longer than any link delay studied
+    buses.settle(f.utime, [&] { track_node.wait_idle(60000); });
     if (simulator.outcome().ended() && end_frame < 0) end_frame = f.seq;
     const pilot::State s = pilot_node.pilot().state();
     if (end_frame >= 0 && (s == pilot::State::Landed || s == pilot::State::Aborted ||
@@ -86,6 +92,8 @@ RunResult fly(const RunConfig& config) {
     if (const int64_t n = track_node.counter("pad_miss_" + track::to_string(miss)))
       r.pad_misses += (r.pad_misses.empty() ? "" : " ") + track::to_string(miss) + ":" + std::to_string(n);
   r.commands_refused = simulator.commands_refused();
+  r.link_down = buses.down_counters();
+  r.link_up = buses.up_counters();
   r.sim_s = simulator.time();
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return r;

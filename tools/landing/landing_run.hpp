@@ -1,17 +1,22 @@
 #pragma once
 // One autonomous landing in lock-step: the flight simulator node, the tracking node and the
 // pilot node — the same classes as aerie-flightsim, aerie-track and aerie-pilot — on one
-// in-process LCM bus (memq://), flown until the simulator reports the flight over. The
-// result depends on the configs and the seed alone. Used by aerie-bench-landing and the
-// closed-loop tests.
+// in-process LCM bus (memq://), flown until the simulator reports the flight over. With a
+// split, "track" and "pilot" may run on the ground side, behind the link in simulation
+// time (tools/link/sim_link.hpp). Each frame, the buses are settled (every message
+// handled, the tracker idle, the link's due messages delivered) before the physics steps,
+// so the result depends on the configs and the seed alone. Used by aerie-bench-landing,
+// aerie-linkstudy and the closed-loop tests.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "air/pilot/pilot.hpp"
 #include "air/track/node/track_node.hpp"
 #include "common/sim/flight/flight_sim.hpp"
+#include "tools/link/sim_link.hpp"
 
 namespace aerie::landing {
 
@@ -22,8 +27,11 @@ struct RunConfig {
   // After the simulator reports the end, frames flown until the pilot says LANDED or
   // ABORTED, at most this many.
   int frames_after_end = 100;
-  // Sees every message on the bus (channel, payload) in bus order, e.g. to record it.
-  std::function<void(const std::string&, const uint8_t*, size_t)> on_message;
+  // Nodes "track" and "pilot" on the ground side, and the link; none: one bus.
+  std::optional<link::Split> split;
+  // Sees every message on each side's bus in bus order, with the simulation time it is
+  // handled at, e.g. to record it (the air side only without a split).
+  link::SplitBus::Tap on_message;
 };
 
 // TARGET_POSE against the truth of its frame, during the pilot's DESCEND; fitted: the pad's
@@ -38,9 +46,11 @@ struct RunResult {
   sim::FlightOutcome outcome;
   std::string final_state;         // the pilot's
   int losses = 0, reacquisitions = 0;
+  int64_t pilot_stale_holds = 0;   // the pilot's HOLDs on stale inputs
   int64_t lockstep_timeouts = 0, target_poses = 0, commands_refused = 0;
   int64_t pad_refined = 0, pad_not_found = 0, tracker_reseeded = 0;  // aerie-track's counters
   std::string pad_misses;          // "reason:count ..." of the frames the pad was not found
+  link::DirectionCounters link_down, link_up;  // with a split
   double sim_s = 0, wall_s = 0;
   std::vector<DescentSample> descent;
   // 0..2: x, y, z (m); 3: yaw (deg); over every DESCEND sample or the fitted ones; NaN without samples

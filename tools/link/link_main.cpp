@@ -14,8 +14,6 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
-#include <regex>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "common/bus/bus.hpp"
@@ -25,7 +23,7 @@
 #include "tools/link/link_config.hpp"
 #include "tools/link/link_model.hpp"
 #include "tools/latency/stats.hpp"
-#include "tools/link/reencode.hpp"
+#include "tools/link/relay.hpp"
 
 namespace {
 
@@ -35,22 +33,6 @@ int64_t mono_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
-
-// LCM channel regexes match whole names (LCM anchors them with ^...$).
-class ChannelMatcher {
- public:
-  explicit ChannelMatcher(const std::string& regex)
-      : re_(regex.empty() ? std::regex("$^") : std::regex(regex, std::regex::extended)) {}
-  bool operator()(const std::string& channel) {
-    const auto it = cache_.find(channel);
-    if (it != cache_.end()) return it->second;
-    return cache_[channel] = std::regex_match(channel, re_);
-  }
-
- private:
-  std::regex re_;
-  std::unordered_map<std::string, bool> cache_;
-};
 
 // What the relay published on a network comes back to its own subscriptions
 // there (multicast loopback): remember it briefly and drop the echo.
@@ -87,11 +69,10 @@ struct Side {
 };
 
 struct Route {
-  link::LinkDirection model;
+  link::Relay relay;
   Side* from;
   Side* to;
-  ChannelMatcher jpeg;
-  ChannelMatcher reverse;    // the other direction's channels: only those can echo back
+  link::ChannelMatcher reverse;  // the other direction's channels: only those can echo back
   std::vector<double> delays_ms;  // achieved over the stats period
   int64_t bytes_at_period_start = 0;
 };
@@ -152,35 +133,23 @@ int main(int argc, char** argv) {
     Side air{"air", std::make_unique<bus::Bus>(cfg.air_url), {}};
     Side ground{"ground", std::make_unique<bus::Bus>(cfg.ground_url), {}};
     std::vector<std::unique_ptr<Route>> routes;
-    routes.push_back(std::make_unique<Route>(Route{link::LinkDirection(cfg.air_to_ground), &air, &ground,
-                                                   ChannelMatcher(cfg.air_to_ground.jpeg_channels),
-                                                   ChannelMatcher(cfg.ground_to_air.channels), {}, 0}));
-    routes.push_back(std::make_unique<Route>(Route{link::LinkDirection(cfg.ground_to_air), &ground, &air,
-                                                   ChannelMatcher(cfg.ground_to_air.jpeg_channels),
-                                                   ChannelMatcher(cfg.air_to_ground.channels), {}, 0}));
+    routes.push_back(std::make_unique<Route>(
+        Route{link::Relay(cfg.air_to_ground), &air, &ground, link::ChannelMatcher(cfg.ground_to_air.channels), {}, 0}));
+    routes.push_back(std::make_unique<Route>(
+        Route{link::Relay(cfg.ground_to_air), &ground, &air, link::ChannelMatcher(cfg.air_to_ground.channels), {}, 0}));
     for (auto& rp : routes) {
       Route& r = *rp;
-      r.from->bus->subscribe_raw(r.model.config().channels, [&r, &cfg](const uint8_t* data, size_t size,
-                                                                       const bus::ReceiveInfo& info) {
+      r.from->bus->subscribe_raw(r.relay.model().config().channels, [&r, &cfg](const uint8_t* data, size_t size,
+                                                                              const bus::ReceiveInfo& info) {
         if (info.channel == cfg.stats_channel) return;
         if (r.from->echo.is_echo(EchoFilter::key(info.channel, data, size))) return;
-        link::Packet p;
-        p.channel = info.channel;
-        p.data.assign(data, data + size);
-        p.recv_wall_utime = info.recv_utime;
-        if (r.jpeg(info.channel)) {
-          if (auto smaller = link::reencode_jpeg(p.data, r.model.config().jpeg_quality)) {
-            p.data = std::move(*smaller);
-            ++r.model.counters().reencoded;
-          }
-        }
-        r.model.offer(std::move(p), mono_us());
+        r.relay.take(info.channel, data, size, info.recv_utime, mono_us());
       }, 10000);
     }
 
     spdlog::info("air {} <-> ground {}", cfg.air_url, cfg.ground_url);
     for (const auto& r : routes) {
-      const auto& d = r->model.config();
+      const auto& d = r->relay.model().config();
       spdlog::info("{}: channels '{}', delay {} ms, jitter {} ms ({}), loss {}, bandwidth {}, queue {} B, seed {}",
                    d.name, d.channels, d.delay_ms, d.jitter_ms, link::to_string(d.jitter),
                    d.loss_model == link::LossModel::Bernoulli ? std::to_string(d.loss)
@@ -197,7 +166,7 @@ int main(int argc, char** argv) {
       int64_t now = mono_us();
       int64_t wake = next_stats;
       for (const auto& r : routes)
-        if (const int64_t t = r->model.next_event_us(); t >= 0) wake = std::min(wake, t);
+        if (const int64_t t = r->relay.model().next_event_us(); t >= 0) wake = std::min(wake, t);
       pollfd fds[2] = {{air.bus->fileno(), POLLIN, 0}, {ground.bus->fileno(), POLLIN, 0}};
       const int64_t wait_us = std::max<int64_t>(0, wake - now);
       const timespec ts{static_cast<time_t>(wait_us / 1000000), static_cast<long>((wait_us % 1000000) * 1000)};
@@ -211,7 +180,7 @@ int main(int argc, char** argv) {
       now = mono_us();
       for (auto& rp : routes) {
         Route& r = *rp;
-        for (auto& p : r.model.due(now)) {
+        for (auto& p : r.relay.due(now)) {
           const uint64_t k = EchoFilter::key(p.channel, p.data.data(), p.data.size());
           if (r.reverse(p.channel)) r.to->echo.sent(k, now);
           r.to->bus->raw().publish(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
@@ -225,9 +194,9 @@ int main(int argc, char** argv) {
         s.period_s = cfg.stats_period_s;
         for (auto& rp : routes) {
           Route& r = *rp;
-          const auto& c = r.model.counters();
+          const auto& c = r.relay.model().counters();
           aerie::link_direction_stats_t d;
-          d.name = r.model.config().name;
+          d.name = r.relay.model().config().name;
           d.received = c.received;
           d.delivered = c.delivered;
           d.bytes_delivered = c.bytes_delivered;
@@ -235,8 +204,8 @@ int main(int argc, char** argv) {
           d.dropped_queue = c.dropped_queue;
           d.dropped_other = c.dropped_other;
           d.reencoded = c.reencoded;
-          d.queue_depth = r.model.queue_depth();
-          d.queue_bytes = r.model.queue_bytes();
+          d.queue_depth = r.relay.model().queue_depth();
+          d.queue_bytes = r.relay.model().queue_bytes();
           const auto delay = latency::summarize(std::move(r.delays_ms));
           d.delay_p50_ms = delay.median;
           d.delay_p90_ms = delay.p90;
@@ -255,10 +224,10 @@ int main(int argc, char** argv) {
       }
     }
     for (const auto& r : routes) {
-      const auto& c = r->model.counters();
+      const auto& c = r->relay.model().counters();
       spdlog::info("{}: received {}, delivered {}, lost {}, queue drops {}, other drops {}, re-encoded {}, {} waiting",
-                   r->model.config().name, c.received, c.delivered, c.dropped_loss, c.dropped_queue, c.dropped_other,
-                   c.reencoded, r->model.queue_depth() + r->model.in_flight());
+                   r->relay.model().config().name, c.received, c.delivered, c.dropped_loss, c.dropped_queue, c.dropped_other,
+                   c.reencoded, r->relay.model().queue_depth() + r->relay.model().in_flight());
     }
   } catch (const std::exception& e) {
     spdlog::critical("{}", e.what());

@@ -31,7 +31,7 @@ TEST(AvoidanceLoop, VoPlusImuFliesPastTheWallParallelAndTheSameTwice) {
   std::vector<std::vector<uint8_t>> commands[2];
   avoidance::RunResult r[2];
   for (int i = 0; i < 2; ++i) {
-    rc.on_message = [&](const std::string& channel, const uint8_t* data, size_t size) {
+    rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
       if (channel == "CTRL_CMD") commands[i].emplace_back(data, data + size);
     };
     r[i] = avoidance::fly(rc, 1);

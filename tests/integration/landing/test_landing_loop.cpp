@@ -34,7 +34,7 @@ struct Message {
 // Every message of a run; TRACK with its processing time (wall clock) zeroed.
 std::vector<Message> record(landing::RunConfig rc, landing::RunResult* result = nullptr) {
   std::vector<Message> out;
-  rc.on_message = [&](const std::string& channel, const uint8_t* data, size_t size) {
+  rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
     Message m{channel, {data, data + size}};
     if (channel == "TRACK") {
       aerie::track_t t;

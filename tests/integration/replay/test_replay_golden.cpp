@@ -45,7 +45,7 @@ std::vector<Message> record_flight() {
   rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
   const std::set<std::string> sensors{"IMU", "GT_POSE", "GT_TRACK", "CAM_DOWN", "CAM_STEREO"};
   std::vector<Message> log;
-  rc.on_message = [&](const std::string& channel, const uint8_t* data, size_t size) {
+  rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
     if (sensors.count(channel)) log.push_back({channel, {data, data + size}});
   };
   landing::fly(rc);

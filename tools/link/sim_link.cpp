@@ -1,0 +1,89 @@
+#include "tools/link/sim_link.hpp"
+
+#include <stdexcept>
+
+namespace aerie::link {
+
+Side side_from_name(const std::string& name) {
+  if (name == "air") return Side::kAir;
+  if (name == "ground") return Side::kGround;
+  throw std::invalid_argument("side must be air or ground, not '" + name + "'");
+}
+
+const char* side_name(Side side) { return side == Side::kAir ? "air" : "ground"; }
+
+Side Split::side(const std::string& node) const {
+  const auto it = nodes.find(node);
+  return it == nodes.end() ? Side::kAir : it->second;
+}
+
+namespace {
+// "" = nothing crosses this way: allowed here (aerie-link's configuration refuses it).
+DirectionConfig none_allowed(DirectionConfig d) {
+  if (d.channels.empty()) d.channels = "$^";
+  return d;
+}
+}  // namespace
+
+SimLink::SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, const DirectionConfig& up)
+    : air_(air), ground_(ground), down_(none_allowed(down)), up_(none_allowed(up)) {
+  // Deep queues: in lock-step nothing may be dropped before the link model decides.
+  if (!down.channels.empty())
+    air_.subscribe_raw(down.channels, [this](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
+      down_.take(info.channel, data, size, info.recv_utime, now_us_);
+    }, 100000);
+  if (!up.channels.empty())
+    ground_.subscribe_raw(up.channels, [this](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
+      up_.take(info.channel, data, size, info.recv_utime, now_us_);
+    }, 100000);
+}
+
+int SimLink::deliver() {
+  int n = 0;
+  for (Relay* r : {&down_, &up_}) {
+    const Side to = r == &down_ ? Side::kGround : Side::kAir;
+    bus::Bus& b = to == Side::kGround ? ground_ : air_;
+    for (const Packet& p : r->due(now_us_)) {
+      b.raw().publish(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
+      ++n;
+    }
+  }
+  return n;
+}
+
+SplitBus::SplitBus(const std::optional<Split>& split) : split_(split), air_("memq://") {
+  if (!split_) return;
+  ground_ = std::make_unique<bus::Bus>("memq://");
+  link_ = std::make_unique<SimLink>(air_, *ground_, split_->down, split_->up);
+}
+
+DirectionCounters SplitBus::down_counters() const { return link_ ? link_->down().model().counters() : DirectionCounters{}; }
+DirectionCounters SplitBus::up_counters() const { return link_ ? link_->up().model().counters() : DirectionCounters{}; }
+
+void SplitBus::tap(Tap tap) {
+  if (!tap) return;
+  for (Side side : {Side::kAir, Side::kGround}) {
+    if (side == Side::kGround && !ground_) break;
+    on(side).subscribe_raw(".*", [this, tap, side](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
+      tap(side, info.channel, data, size, now_us_);
+    }, 100000);
+  }
+}
+
+void SplitBus::settle(int64_t now_us, const std::function<void()>& wait_workers) {
+  now_us_ = now_us;
+  if (link_) link_->set_time(now_us);
+  while (true) {
+    int n = 0;
+    for (int round = 0; round < 2; ++round) {  // before and after the workers' outputs
+      while (air_.handle(0) > 0) ++n;
+      if (ground_)
+        while (ground_->handle(0) > 0) ++n;
+      if (round == 0 && wait_workers) wait_workers();
+    }
+    if (link_) n += link_->deliver();
+    if (n == 0) return;
+  }
+}
+
+}  // namespace aerie::link

@@ -1,0 +1,85 @@
+#pragma once
+// The air-ground link in simulation time, for split deployments flown in lock-step.
+//
+// Two in-process buses (memq://) stand for the air and the ground networks; a Relay per
+// direction joins them on the simulation's clock. What a side publishes on a direction's
+// channels is offered to the link at the current simulation time (set_time) and published
+// on the other side once the link model delivers it. Nothing waits on a wall clock, so a
+// run delivers the same messages at the same simulation times on a loaded machine as on a
+// quiet one. Nodes see a delivery when the driver settles the buses: in a frame-stepped
+// simulation, at the first frame at or after its delivery time.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "common/bus/bus.hpp"
+#include "tools/link/relay.hpp"
+
+namespace aerie::link {
+
+enum class Side { kAir, kGround };
+Side side_from_name(const std::string& name);  // air | ground; throws std::invalid_argument naming it
+const char* side_name(Side side);
+
+// Where each node runs, and the link between the two sides.
+struct Split {
+  std::map<std::string, Side> nodes;  // nodes not named run on the air side
+  DirectionConfig down, up;           // air->ground and ground->air; `channels` says what crosses ("" = nothing)
+  Side side(const std::string& node) const;
+};
+
+class SimLink {
+ public:
+  SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, const DirectionConfig& up);
+  SimLink(const SimLink&) = delete;
+  SimLink& operator=(const SimLink&) = delete;
+
+  // The simulation time (µs) at which what is published from now on is offered.
+  void set_time(int64_t now_us) { now_us_ = now_us; }
+  int64_t time() const { return now_us_; }
+  // Publishes on the far side what the link delivers by now; returns how many messages.
+  int deliver();
+
+  Relay& down() { return down_; }
+  Relay& up() { return up_; }
+
+ private:
+  bus::Bus &air_, &ground_;
+  Relay down_, up_;
+  int64_t now_us_ = 0;
+};
+
+// The buses of a lock-step run: one (every node on it) or, with a split, the air and the
+// ground buses joined by a SimLink.
+class SplitBus {
+ public:
+  explicit SplitBus(const std::optional<Split>& split);
+  bus::Bus& on(Side side) { return side == Side::kGround && ground_ ? *ground_ : air_; }
+  bus::Bus& of(const std::string& node) { return on(split_ ? split_->side(node) : Side::kAir); }
+  SimLink* link() { return link_.get(); }
+  // What each direction received, delivered and dropped (zeros without a split).
+  DirectionCounters down_counters() const;
+  DirectionCounters up_counters() const;
+
+  // A message on a side's bus, with the simulation time (µs) it is handled at.
+  using Tap = std::function<void(Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us)>;
+  // `tap` sees every message on each bus (one side only without a split), e.g. to log it.
+  void tap(Tap tap);
+
+  // Handles every message pending on the buses and delivers what the link has due at
+  // now_us, round after round, until nothing is left. wait_workers (may be empty) waits
+  // for the nodes' own threads (e.g. the tracker's) at each round.
+  void settle(int64_t now_us, const std::function<void()>& wait_workers = {});
+
+ private:
+  std::optional<Split> split_;
+  int64_t now_us_ = 0;
+  bus::Bus air_;
+  std::unique_ptr<bus::Bus> ground_;
+  std::unique_ptr<SimLink> link_;
+};
+
+}  // namespace aerie::link
