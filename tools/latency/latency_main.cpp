@@ -9,15 +9,21 @@
 #include "common/logio/event_log.hpp"
 #include "common/util/cli.hpp"
 #include "tools/latency/latency.hpp"
+#include "tools/latency/link_hops.hpp"
 
 int main(int argc, char** argv) {
   using namespace aerie;
   CLI::App app{
       "aerie-latency: end-to-end latency of every channel of an LCM log (receive time in the log minus\n"
-      "the message's source utime) as median/p90/p99/max, and per hop from the nodes' STATUS_* messages."};
-  std::string log_path, csv, json, log_level = "info";
+      "the message's source utime) as median/p90/p99/max, and per hop from the nodes' STATUS_* messages.\n"
+      "Given a second log (a split deployment: the air side's log, then the ground side's), also the\n"
+      "link's hop per channel: the receiving side's log time minus the sending side's."};
+  std::string log_path, ground_log_path, csv, json, log_level = "info";
   latency::LatencyAnalysis::Options opts;
-  app.add_option("log", log_path, "LCM log file (lcm-logger)")->required()->check(CLI::ExistingFile);
+  app.add_option("log", log_path, "LCM log file (lcm-logger); the air side's in a split deployment")
+      ->required()->check(CLI::ExistingFile);
+  app.add_option("ground_log", ground_log_path, "the ground side's LCM log of the same flight (clocks synchronised)")
+      ->check(CLI::ExistingFile);
   app.add_option("--channels", opts.channels, "regex of the channels to report (whole names)")->capture_default_str();
   app.add_flag("--unknown-types", opts.unknown_types,
                "also read utime from payloads of types outside Aerie's catalogue (assumes utime comes first)");
@@ -35,6 +41,17 @@ int main(int argc, char** argv) {
     const auto channels = analysis.channels();
     const auto hops = analysis.hops();
     std::cout << log_path << ": " << analysis.events() << " events\n\n" << latency::format_table(channels, hops);
+    if (!ground_log_path.empty()) {
+      latency::LinkJoin join;
+      for (const auto& [path, side] : {std::pair{log_path, latency::LinkJoin::Log::kAir},
+                                       std::pair{ground_log_path, latency::LinkJoin::Log::kGround}}) {
+        logio::Reader r(path, logio::Reader::Options{.resync = true});
+        logio::Event e;
+        while (r.next(e)) join.add(side, e.channel, e.utime, e.data.data(), e.data.size());
+        for (const auto& d : r.damage()) spdlog::warn("{}", d.message);
+      }
+      std::cout << '\n' << latency::format_link_table(join.hops());
+    }
     auto write = [](const std::string& path, const std::string& text) {
       std::ofstream out(path);
       if (!(out << text)) throw std::runtime_error("cannot write '" + path + "'");
