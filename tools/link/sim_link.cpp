@@ -1,5 +1,6 @@
 #include "tools/link/sim_link.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace aerie::link {
@@ -49,6 +50,11 @@ int SimLink::deliver() {
     }
   }
   return n;
+}
+
+int64_t SimLink::next_event_us() const {
+  const int64_t d = down_.model().next_event_us(), u = up_.model().next_event_us();
+  return d < 0 ? u : u < 0 ? d : std::min(d, u);
 }
 
 SplitBus::SplitBus(const std::optional<Split>& split) : split_(split), air_("memq://") {

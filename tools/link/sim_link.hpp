@@ -42,6 +42,8 @@ class SimLink {
   int64_t time() const { return now_us_; }
   // Publishes on the far side what the link delivers by now; returns how many messages.
   int deliver();
+  // When the link next delivers (or sends) something; -1 when it is empty.
+  int64_t next_event_us() const;
 
   Relay& down() { return down_; }
   Relay& up() { return up_; }

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
   std::vector<linkstudy::RunSpec> specs;
   for (auto w : study.workloads)
     for (const auto& p : study.placements)
-      for (const auto& t : w == linkstudy::Workload::kLanding ? study.trackers : std::vector<std::string>{"-"})
+      for (const auto& t : w != linkstudy::Workload::kAvoidance ? study.trackers : std::vector<std::string>{"-"})
         for (const auto& [name, c] : conditions)
           for (int i = 0; i < study.seeds; ++i)
             specs.push_back({c, &p, w, t, study.first_seed + static_cast<uint64_t>(i)});

@@ -24,7 +24,8 @@ def main(out):
     for (workload, sweep), lines in groups.items():
         for what, ylabel, fn in (
                 ("success", "success rate (%)", lambda rs: 100 * sum(int(r["success"]) for r in rs) / len(rs)),
-                ("metric", "touchdown error (cm)" if workload == "landing" else "steady heading RMSE (deg)",
+                ("metric", {"landing": "touchdown error (cm)", "avoidance": "steady heading RMSE (deg)",
+                            "replay": "AUC of the boxes the operator received"}[workload],
                  lambda rs: mean([float(r["value"]) * (100 if workload == "landing" else 1)
                                   for r in rs if float(r["value"]) >= 0])),
                 ("view_age", "operator's view age, median (ms)",

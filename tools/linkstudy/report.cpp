@@ -71,6 +71,7 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
     }
     c.stale_holds += static_cast<double>(r.pilot_stale_holds);
     c.fallbacks += static_cast<double>(r.control_fallbacks);
+    c.frames_lost += static_cast<double>(r.frames_lost);
     c.down_kbit_s += r.down_kbit_s;
     c.down_lost += static_cast<double>(r.down.dropped_loss);
     c.down_queue_dropped += static_cast<double>(r.down.dropped_queue);
@@ -92,12 +93,13 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
   std::ofstream md(out_dir + "/report.md");
   md << "# Link study\n\n" << flown << " of " << specs.size() << " flights, " << study.seeds << " seeds each (from "
      << study.first_seed << "), lock-step: " << fmt("%.0f", sim_s) << " simulated s in " << fmt("%.0f", wall)
-     << " s of flight-thread time. Rows: `study.csv`. Each cell: success rate, then the mean of the error metric "
-        "(landing: touchdown error, cm, over the landed runs; avoidance: steady-state heading RMSE, deg).\n";
+     << " s of flight-thread time. Rows: `study.csv`. Each cell: success rate, then the mean of the metric "
+        "(landing: touchdown error, cm, over the landed runs; avoidance: steady-state heading RMSE, deg, over the "
+        "settled runs; replay: the AUC of the boxes that reached the operator).\n";
   for (Workload w : study.workloads) {
-    const bool land = w == Workload::kLanding;
-    md << "\n## " << (land ? "Landing" : "Avoidance") << "\n";
-    const std::vector<std::string> trackers = land ? study.trackers : std::vector<std::string>{"-"};
+    const bool land = w == Workload::kLanding, replay = w == Workload::kReplay;
+    md << "\n## " << (land ? "Landing" : replay ? "Replay (open loop)" : "Avoidance") << "\n";
+    const std::vector<std::string> trackers = w != Workload::kAvoidance ? study.trackers : std::vector<std::string>{"-"};
     for (const Sweep& sw : study.sweeps) {
       md << "\n### Against " << sw.factor << "\n\n![success](" << workload_name(w) << "_success_vs_" << sw.factor
          << ".png) ![view age](" << workload_name(w) << "_view_age_vs_" << sw.factor << ".png)\n\n| placement | tracker |";
@@ -132,7 +134,7 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
         }
       // The operator's view and the fallbacks, per placement (first tracker).
       md << "\n| placement | " << sw.factor << " | view age p50 / p95 (ms) | "
-         << (land ? "pilot stale HOLDs / run" : "control fallback commands / run")
+         << (land ? "pilot stale HOLDs / run" : replay ? "frames lost / run" : "control fallback commands / run")
          << " | air->ground kbit/s | lost / queue-dropped per run (air->ground) |\n|---|---|---|---|---|---|\n";
       for (const auto& p : study.placements)
         for (const auto& c : sw.conditions) {
@@ -142,7 +144,7 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
           md << "| " << p.name << " | " << factor_value(c, sw.factor) << " | "
              << (cell.age_n ? fmt("%.0f", cell.age_p50_sum / cell.age_n) + " / " + fmt("%.0f", cell.age_p95_sum / cell.age_n)
                             : "—")
-             << " | " << fmt("%.2f", (land ? cell.stale_holds : cell.fallbacks) / n) << " | "
+             << " | " << fmt("%.2f", (land ? cell.stale_holds : replay ? cell.frames_lost : cell.fallbacks) / n) << " | "
              << fmt("%.0f", cell.down_kbit_s / n) << " | " << fmt("%.1f", cell.down_lost / n) << " / "
              << fmt("%.1f", cell.down_queue_dropped / n) << " |\n";
         }

@@ -19,7 +19,7 @@ struct Cell {
   int metric_n = 0;
   double age_p50_sum = 0, age_p95_sum = 0;
   int age_n = 0;
-  double stale_holds = 0, fallbacks = 0, down_kbit_s = 0, down_lost = 0, down_queue_dropped = 0;
+  double stale_holds = 0, fallbacks = 0, frames_lost = 0, down_kbit_s = 0, down_lost = 0, down_queue_dropped = 0;
   // channel -> (direction, hop latency medians of the runs, sent, delivered)
   struct Hop {
     std::string direction;

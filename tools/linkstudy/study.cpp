@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -14,6 +15,7 @@
 #include "common/logio/event_log.hpp"
 #include "common/sim/flight/flight_config.hpp"
 #include "tools/latency/stats.hpp"
+#include "tools/linkstudy/replay_run.hpp"
 
 namespace aerie::linkstudy {
 
@@ -56,6 +58,8 @@ struct NodeIo {
 };
 
 std::vector<NodeIo> node_io(const StudyConfig& s, Workload w) {
+  if (w == Workload::kReplay)  // "sim": the log played back on the air side
+    return {{"sim", {}, {"CAM_DOWN", "GT_TRACK"}}, {"track", {"CAM_DOWN", "GT_TRACK"}, {"TRACK", "TARGET_POSE"}}};
   if (w == Workload::kLanding)
     return {{"sim", {"CTRL_CMD"}, {"IMU", "CAM_DOWN", "GT_TRACK"}},
             {"track", {"CAM_DOWN", "GT_TRACK"}, {"TRACK", "TARGET_POSE"}},
@@ -72,6 +76,7 @@ std::vector<NodeIo> node_io(const StudyConfig& s, Workload w) {
 // What the operator watches on the ground: the landing camera with the tracker's box and the
 // pilot's state; the vehicle's heading estimate and commands during avoidance.
 std::vector<std::string> operator_channels(const StudyConfig& s, Workload w) {
+  if (w == Workload::kReplay) return {"TRACK", "CAM_DOWN"};
   if (w == Workload::kLanding) return {"CAM_DOWN", "TRACK", "PILOT_STATE"};
   return {s.avoidance.source == avoidance::Source::kGt ? "GT_POSE"
           : s.avoidance.source == avoidance::Source::kVo ? "VO_POSE"
@@ -97,10 +102,13 @@ std::string names(const std::vector<T>& v) {
 Workload workload_from_name(const std::string& name) {
   if (name == "landing") return Workload::kLanding;
   if (name == "avoidance") return Workload::kAvoidance;
-  throw std::invalid_argument("workload must be landing or avoidance, not '" + name + "'");
+  if (name == "replay") return Workload::kReplay;
+  throw std::invalid_argument("workload must be landing, avoidance or replay, not '" + name + "'");
 }
 
-const char* workload_name(Workload w) { return w == Workload::kLanding ? "landing" : "avoidance"; }
+const char* workload_name(Workload w) {
+  return w == Workload::kLanding ? "landing" : w == Workload::kAvoidance ? "avoidance" : "replay";
+}
 
 std::string Condition::name() const {
   std::string n = "delay" + num(delay_ms) + "_jit" + num(jitter_ms) + "_loss" + num(loss);
@@ -158,7 +166,7 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
   std::vector<std::string> known{"seeds.first", "seeds.count", "queue_bytes", "workloads", "trackers", "placements",
                                  "baseline.loss_model", "landing.sim", "landing.track", "landing.pilot",
                                  "landing.wind_m_s", "landing.vibration", "landing.max_time_s", "avoidance.config",
-                                 "avoidance.controller", "avoidance.source", "avoidance.speed_m_s"};
+                                 "avoidance.controller", "avoidance.source", "avoidance.speed_m_s", "replay.log"};
   for (const Factor& f : kFactors) {
     known.push_back(std::string("baseline.") + f.key);
     known.push_back(std::string("sweeps.") + f.key + ".values");
@@ -245,14 +253,21 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
     if (!track::is_known_tracker(t)) fail("trackers", "unknown tracker '" + t + "'");
 
   const auto has = [&](Workload w) { return std::find(s.workloads.begin(), s.workloads.end(), w) != s.workloads.end(); };
+  if (has(Workload::kReplay)) {
+    if (!cfg.has("replay.log")) fail("replay.log", "the replay workload needs a recorded log (e.g. aerie-bench-landing --log-dir)");
+    s.replay_log = path(cfg.get<std::string>("replay.log", ""));
+    if (!std::filesystem::is_regular_file(s.replay_log)) fail("replay.log", "'" + s.replay_log + "' is not a file");
+  }
+  if (has(Workload::kLanding) || has(Workload::kReplay)) {
+    s.track_file = path(cfg.get<std::string>("landing.track", "config/track_landing.yaml"));
+    track::node_options(util::Config::load(s.track_file));  // refused now rather than in every run
+  }
   if (has(Workload::kLanding)) {
     s.landing.sim = sim::load_flight_config(util::Config::load(path(cfg.get<std::string>("landing.sim", "config/sim/landing_room.yaml"))));
     s.landing.sim.wind.mean_m_s = cfg.get_in("landing.wind_m_s", s.landing.sim.wind.mean_m_s, 0.0, 20.0);
     s.landing.sim.vibration.enabled = cfg.get("landing.vibration", s.landing.sim.vibration.enabled);
     s.landing.sim.max_time_s = cfg.get_in("landing.max_time_s", s.landing.sim.max_time_s, 1.0, 3600.0);
     s.landing.pilot = pilot::load_pilot_config(util::Config::load(path(cfg.get<std::string>("landing.pilot", "config/pilot.yaml"))));
-    s.track_file = path(cfg.get<std::string>("landing.track", "config/track_landing.yaml"));
-    track::node_options(util::Config::load(s.track_file));  // refused now rather than in every run
   }
   if (has(Workload::kAvoidance)) {
     s.avoidance = avoidance::load_run_config(
@@ -342,6 +357,29 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     row.final_state = r.final_state;
     row.sim_s = r.sim_s;
     row.wall_s = r.wall_s;
+  } else if (spec.workload == Workload::kReplay) {
+    ReplayConfig rc;
+    rc.log = study.replay_log;
+    rc.track = track::node_options(util::Config::load(study.track_file));
+    rc.track.tracker = spec.tracker;
+    rc.track.seed = spec.seed;
+    rc.split = split;
+    rc.on_message = tap;
+    const ReplayResult r = replay(rc);
+    row.metric = "auc";
+    row.auc = row.value = r.auc;
+    row.mean_iou = r.mean_iou;
+    row.centre_error_px = r.centre_error_px;
+    row.frames_visible = r.frames_visible;
+    row.frames_lost = r.frames_lost;
+    // The operator had a box on the target in at least 90 % of the frames it was visible in.
+    row.success = r.frames_visible > 0 && r.auc > 0 &&
+                  static_cast<double>(r.frames_visible - r.frames_lost) >= 0.9 * static_cast<double>(r.frames_visible) &&
+                  r.mean_iou >= 0.5;
+    row.down = r.down;
+    row.up = r.up;
+    row.final_state = "replayed";
+    row.sim_s = r.sim_s;
   } else {
     avoidance::RunConfig rc = study.avoidance;
     rc.split = split;
@@ -376,7 +414,7 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
 std::string csv_header() {
   return "condition,delay_ms,loss,bandwidth_mbit,placement,workload,tracker,seed,success,metric,value,"
          "sweep,jitter_ms,loss_model,burst_length,jpeg_quality,collision,touchdown_error_m,yaw_error_deg,time_s,losses,"
-         "target_rmse_xy_m,heading_rmse_deg,entered_danger,view_age_p50_ms,view_age_p95_ms,view_messages,"
+         "target_rmse_xy_m,heading_rmse_deg,entered_danger,mean_iou,centre_error_px,frames_visible,frames_lost,view_age_p50_ms,view_age_p95_ms,view_messages,"
          "pilot_stale_holds,control_fallbacks,down_received,down_delivered,down_lost,down_queue_dropped,"
          "up_received,up_delivered,up_lost,up_queue_dropped,down_kbit_s,up_kbit_s,final_state,sim_s";
 }
@@ -390,7 +428,8 @@ std::string csv_row(const std::string& sweep, const RunSpec& spec, const RunRow&
     << (c.loss_model == link::LossModel::Bernoulli ? "bernoulli" : "gilbert_elliott") << ',' << c.burst_length << ','
     << c.jpeg_quality << ','
     << r.collision << ',' << r.touchdown_error_m << ',' << r.yaw_error_deg << ',' << r.time_s << ',' << r.losses << ','
-    << r.target_rmse_xy_m << ',' << r.heading_rmse_deg << ',' << r.entered_danger << ',' << r.view_age_p50_ms << ','
+    << r.target_rmse_xy_m << ',' << r.heading_rmse_deg << ',' << r.entered_danger << ',' << r.mean_iou << ','
+    << r.centre_error_px << ',' << r.frames_visible << ',' << r.frames_lost << ',' << r.view_age_p50_ms << ','
     << r.view_age_p95_ms << ',' << r.view_messages << ',' << r.pilot_stale_holds << ',' << r.control_fallbacks << ','
     << r.down.received << ',' << r.down.delivered << ',' << r.down.dropped_loss << ',' << r.down.dropped_queue << ','
     << r.up.received << ',' << r.up.delivered << ',' << r.up.dropped_loss << ',' << r.up.dropped_queue << ','

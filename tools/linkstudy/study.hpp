@@ -16,8 +16,8 @@
 
 namespace aerie::linkstudy {
 
-enum class Workload { kLanding, kAvoidance };
-Workload workload_from_name(const std::string& name);  // landing | avoidance
+enum class Workload { kLanding, kAvoidance, kReplay };
+Workload workload_from_name(const std::string& name);  // landing | avoidance | replay
 const char* workload_name(Workload w);
 
 // One link condition, the same in both directions.
@@ -49,7 +49,7 @@ struct StudyConfig {
   std::vector<Sweep> sweeps;
   std::vector<Placement> placements;
   std::vector<Workload> workloads;
-  std::vector<std::string> trackers{"amcmr-ct"};  // landing workload
+  std::vector<std::string> trackers{"amcmr-ct"};  // landing and replay workloads
   uint64_t first_seed = 1;
   int seeds = 3;
   int64_t queue_bytes = 262144;    // the radio's buffer per direction
@@ -58,6 +58,8 @@ struct StudyConfig {
   std::string track_file;          // the tracker's options are read per run (not thread-safe to share)
   // avoidance workload
   avoidance::RunConfig avoidance;
+  // replay workload (open loop): a recorded log through the link; the tracker as landing.track says
+  std::string replay_log, replay_track_file;
 };
 
 // The built-in placements (docs/linkstudy.md):
@@ -91,12 +93,14 @@ struct RunSpec {
 
 struct RunRow {
   bool success = false, collision = false;
-  std::string metric;              // touchdown_error_m (landing) or heading_rmse_deg (avoidance)
+  std::string metric;              // touchdown_error_m (landing), heading_rmse_deg (avoidance) or auc (replay)
   double value = 0;
   double touchdown_error_m = -1, yaw_error_deg = -1, time_s = -1;  // landing
   int losses = 0;
   double target_rmse_xy_m = -1;    // landing: TARGET_POSE during the descent, the poses descended on
   double heading_rmse_deg = -1;    // avoidance
+  double auc = -1, mean_iou = -1, centre_error_px = -1;  // replay: the boxes that reached the operator
+  int64_t frames_visible = 0, frames_lost = 0;
   bool entered_danger = false;
   double view_age_p50_ms = -1, view_age_p95_ms = -1;  // the operator's view, behind the vehicle
   int64_t view_messages = 0;

@@ -1,0 +1,38 @@
+#pragma once
+// The link study's open-loop workload: a recorded flight log replayed through the link in
+// simulation time, the tracker on the side its placement names, scored on what reaches the
+// operator on the ground. Each frame's TRACK box that arrives on the ground is compared with
+// the log's GT_TRACK box of the same frame (the truth never crosses the link):
+//   AUC            mean over IoU thresholds 0, 0.05, ..., 1 of the share of frames above it
+//                  (the OTB success plot's area); a frame whose box never arrives counts as IoU 0;
+//   centre error   mean pixel distance of the boxes that arrived;
+//   frames lost    frames with the target visible for which no tracked box arrived.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "air/track/node/track_node.hpp"
+#include "tools/link/sim_link.hpp"
+
+namespace aerie::linkstudy {
+
+struct ReplayConfig {
+  std::string log;                 // an LCM log with the camera channel and GT_TRACK (e.g. aerie-bench-landing --log-dir)
+  track::NodeOptions track;        // its camera channel is replayed; init_from_gt initialises it on GT_TRACK
+  std::optional<link::Split> split;
+  link::SplitBus::Tap on_message;  // every message on each side, with its simulation time
+};
+
+struct ReplayResult {
+  int64_t frames = 0, frames_visible = 0, frames_lost = 0;
+  double auc = 0, mean_iou = 0, centre_error_px = -1;
+  link::DirectionCounters down, up;
+  double sim_s = 0;
+};
+
+// Throws std::runtime_error naming the log when it cannot be read or has no frame on the camera channel.
+ReplayResult replay(const ReplayConfig& config);
+
+}  // namespace aerie::linkstudy
