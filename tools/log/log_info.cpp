@@ -1,6 +1,7 @@
 #include "tools/log/log_info.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <functional>
@@ -11,6 +12,18 @@
 
 namespace aerie::logtools {
 namespace {
+
+// Sums and differences of values read from the log (seq, frames_skipped, event numbers,
+// utimes) saturate instead of overflowing: a crafted log gives large counts, not undefined
+// behaviour (fuzzing, docs/fuzz.md).
+int64_t sat_add(int64_t a, int64_t b) {
+  int64_t r;
+  return __builtin_add_overflow(a, b, &r) ? (b > 0 ? INT64_MAX : INT64_MIN) : r;
+}
+int64_t sat_sub(int64_t a, int64_t b) {
+  int64_t r;
+  return __builtin_sub_overflow(a, b, &r) ? (b < 0 ? INT64_MAX : INT64_MIN) : r;
+}
 
 std::string format_time(int64_t utime) {
   const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
@@ -55,7 +68,7 @@ struct Accumulator {
 template <typename Count>
 int64_t sum(const std::vector<ChannelSummary>& channels, Count count) {
   int64_t n = 0;
-  for (const auto& c : channels) n += count(c);
+  for (const auto& c : channels) n = sat_add(n, count(c));
   return n;
 }
 
@@ -86,8 +99,8 @@ LogSummary summarize(const std::string& path, bool resync) {
     if (out.events == 0) out.first_utime = ev.utime;
     out.last_utime = std::max(out.last_utime, ev.utime);
     ++out.events;
-    if (last_event_number && ev.event_number > *last_event_number + 1)
-      out.event_number_gaps += ev.event_number - *last_event_number - 1;
+    if (last_event_number && ev.event_number > sat_add(*last_event_number, 1))
+      out.event_number_gaps = sat_add(out.event_number_gaps, sat_sub(sat_sub(ev.event_number, *last_event_number), 1));
     last_event_number = ev.event_number;
 
     auto& a = acc[ev.channel];
@@ -96,7 +109,7 @@ LogSummary summarize(const std::string& path, bool resync) {
       c.channel = ev.channel;
       c.first_utime = ev.utime;
     } else {
-      c.max_gap_s = std::max(c.max_gap_s, (ev.utime - c.last_utime) * 1e-6);
+      c.max_gap_s = std::max(c.max_gap_s, static_cast<double>(sat_sub(ev.utime, c.last_utime)) * 1e-6);
     }
     c.last_utime = ev.utime;
     ++c.count;
@@ -122,8 +135,9 @@ LogSummary summarize(const std::string& path, bool resync) {
     }
     if (st.frames_skipped) {  // cumulative: count what it grew by during the log (from 0 after a restart)
       if (a.last_frames_skipped)
-        c.frames_skipped += *st.frames_skipped >= *a.last_frames_skipped ? *st.frames_skipped - *a.last_frames_skipped
-                                                                           : *st.frames_skipped;
+        c.frames_skipped = sat_add(c.frames_skipped, *st.frames_skipped >= *a.last_frames_skipped
+                                                         ? sat_sub(*st.frames_skipped, *a.last_frames_skipped)
+                                                         : *st.frames_skipped);
       a.last_frames_skipped = st.frames_skipped;
     }
     if (!st.seq) continue;
@@ -131,22 +145,22 @@ LogSummary summarize(const std::string& path, bool resync) {
     c.seq_follows_frames = seq_follows_frames(type->name);
     if (a.last_seq) {
       // A missing seq is a dropped message unless a corrupt message took its place.
-      const int64_t missing = *st.seq - *a.last_seq - 1;
-      if (missing > 0) c.seq_gaps += std::max<int64_t>(0, missing - a.undecodable_since_seq);
+      const int64_t missing = sat_sub(sat_sub(*st.seq, *a.last_seq), 1);
+      if (missing > 0) c.seq_gaps = sat_add(c.seq_gaps, std::max<int64_t>(0, sat_sub(missing, a.undecodable_since_seq)));
       if (*st.seq <= *a.last_seq) ++c.seq_restarts;
     }
     a.last_seq = st.seq;
     a.undecodable_since_seq = 0;
   }
   out.damage = reader.damage();
-  out.duration_s = out.events ? (out.last_utime - out.first_utime) * 1e-6 : 0.0;
+  out.duration_s = out.events ? static_cast<double>(sat_sub(out.last_utime, out.first_utime)) * 1e-6 : 0.0;
   for (auto& [name, a] : acc) {
     auto& c = a.s;
     c.type = a.types.size() == 1 ? a.types[0] : "mixed:";
     if (a.types.size() > 1)
       for (const auto& t : a.types) c.type += " " + t;
     if (c.count > 1 && c.last_utime > c.first_utime)
-      c.rate_hz = static_cast<double>(c.count - 1) / ((c.last_utime - c.first_utime) * 1e-6);
+      c.rate_hz = static_cast<double>(c.count - 1) / (static_cast<double>(sat_sub(c.last_utime, c.first_utime)) * 1e-6);
     out.channels.push_back(std::move(c));
   }
   return out;

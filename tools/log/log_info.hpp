@@ -31,7 +31,10 @@ struct ChannelSummary {
   int64_t undecodable = 0;  // payloads that did not decode as their type
 
   int64_t logger_lost() const { return seq_follows_frames ? 0 : seq_gaps; }  // published, not in the log
-  int64_t producer_skipped() const { return (seq_follows_frames ? seq_gaps : 0) + frames_skipped; }
+  int64_t producer_skipped() const {  // saturating: the counts come from the log
+    int64_t r;
+    return __builtin_add_overflow(seq_follows_frames ? seq_gaps : 0, frames_skipped, &r) ? INT64_MAX : r;
+  }
 };
 
 struct LogSummary {

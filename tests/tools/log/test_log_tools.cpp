@@ -733,5 +733,32 @@ TEST(LogDiff, ExitStatusOfTheCommand) {
   EXPECT_NE(help.out.find("paired by their order within the channel"), std::string::npos) << help.out;
 }
 
+TEST(LogInfo, HostileSequenceNumbersSaturateInsteadOfOverflowing) {
+  // Fuzzing (fuzz/regressions/event_log/seq_gap_sum_overflow.lcm): seq and frames_skipped read
+  // from a log were subtracted and summed in int64_t, which a crafted log overflows.
+  const auto dir = test::scratch_dir("log");
+  const auto path = (dir / "seq.lcm").string();
+  {
+    logio::Writer w(path);
+    for (int64_t seq : {INT64_MIN + 1, INT64_MAX - 1, int64_t{0}, INT64_MAX}) {
+      aerie::track_t t{};
+      t.utime = 1000;
+      t.seq = seq;
+      t.frames_skipped = seq > 0 ? seq : 0;
+      t.tracker = "x";
+      t.camera = "x";
+      std::vector<uint8_t> b(static_cast<size_t>(t.getEncodedSize()));
+      t.encode(b.data(), 0, static_cast<int>(b.size()));
+      w.write(seq == 0 ? INT64_MIN / 2 : INT64_MAX / 2, "TRACK", b.data(), b.size());
+    }
+  }
+  const auto s = summarize(path);
+  ASSERT_EQ(s.channels.size(), 1u);
+  EXPECT_EQ(s.channels[0].seq_gaps, INT64_MAX);
+  EXPECT_GE(s.channels[0].frames_skipped, 0);
+  EXPECT_EQ(s.producer_skipped(), INT64_MAX);
+  EXPECT_TRUE(std::isfinite(s.duration_s));
+}
+
 }  // namespace
 }  // namespace aerie::logtools
