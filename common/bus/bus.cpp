@@ -57,7 +57,8 @@ Bus::~Bus() {
 
 Subscription& Bus::attach(std::unique_ptr<Subscription> sub, const std::string& channel, int queue_capacity) {
   sub->channel_ = channel;
-  sub->handle_ = lcm_.subscribe(channel, &Subscription::on_raw, sub.get());
+  // LCM matches "^" + regex + "$": grouped, alternatives ("A|B") match whole names only.
+  sub->handle_ = lcm_.subscribe("(" + channel + ")", &Subscription::on_raw, sub.get());
   if (!sub->handle_) throw std::runtime_error("cannot subscribe to " + channel);
   sub->handle_->setQueueCapacity(queue_capacity);
   subs_.push_back(std::move(sub));

@@ -95,3 +95,16 @@ TEST(Bus, RawSubscriptionSeesAnyTypeAndPeeksUtime) {
   EXPECT_EQ(got[0], std::make_pair(std::string("VO_POSE"), int64_t{1234567890123}));
   EXPECT_EQ(got[1].second, -1);
 }
+
+TEST(Bus, ChannelRegexWithAlternativesMatchesWholeNamesOnly) {
+  // LCM anchors a subscription as ^REGEX$; with alternatives that anchors only the first and the
+  // last ("^A|B$"), so "TRACK|X" used to take "GT_TRACK" and "TRACK_CMD" too. The bus groups it.
+  Bus bus("memq://");
+  std::vector<std::string> got;
+  bus.subscribe_raw("TRACK|CAM_DOWN", [&](const uint8_t*, size_t, const ReceiveInfo& info) { got.push_back(info.channel); });
+  const uint8_t b[16] = {};
+  for (const char* ch : {"TRACK", "GT_TRACK", "TRACK_CMD", "CAM_DOWN", "CAM_DOWN2", "XCAM_DOWN"}) bus.raw().publish(ch, b, sizeof b);
+  while (bus.handle(0) > 0) {
+  }
+  EXPECT_EQ(got, (std::vector<std::string>{"TRACK", "CAM_DOWN"}));
+}
