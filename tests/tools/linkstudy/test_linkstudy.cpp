@@ -79,7 +79,7 @@ TEST(LinkStudy, BadStudyIsRefusedNamingTheField) {
 }
 
 TEST(LinkStudy, ShippedStudiesLoad) {
-  for (const char* f : {"/config/linkstudy/quick.yaml", "/config/linkstudy/placements.yaml"})
+  for (const char* f : {"/config/linkstudy/quick.yaml", "/config/linkstudy/placements.yaml", "/config/linkstudy/delay_edge.yaml"})
     EXPECT_NO_THROW(linkstudy::load_study(util::Config::load(kSource + f), kSource)) << f;
   // trackers.yaml replays a landing recorded under logs/ (the file says how): until it is, that is what it says.
   try {
