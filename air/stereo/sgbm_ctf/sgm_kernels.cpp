@@ -296,6 +296,9 @@ void SelectRow(const SelectRowArgs& a) {
   }
 }
 
+// The target this copy was compiled for: dispatched like the kernels, it names the one they take.
+int64_t CompiledTarget() { return HWY_TARGET; }
+
 }  // namespace HWY_NAMESPACE
 }  // namespace aerie::stereo::kernels
 HWY_AFTER_NAMESPACE();
@@ -307,6 +310,7 @@ HWY_EXPORT(Census);
 HWY_EXPORT(CostRow);
 HWY_EXPORT(AggregatePass);
 HWY_EXPORT(SelectRow);
+HWY_EXPORT(CompiledTarget);
 
 void census(const CensusArgs& a) { HWY_DYNAMIC_DISPATCH(Census)(a); }
 void cost_row(const CostRowArgs& a) { HWY_DYNAMIC_DISPATCH(CostRow)(a); }
@@ -319,10 +323,7 @@ size_t pass_scratch_size(int width, int window, int paths) {
   return static_cast<size_t>(ndirs) * 2 * (rowlen + width) + 2 * (window + 2);
 }
 
-const char* target_name() {
-  const int64_t targets = hwy::SupportedTargets() & HWY_TARGETS;
-  return hwy::TargetName(targets & -targets);
-}
+const char* target_name() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }
 
 }  // namespace aerie::stereo::kernels
 #endif  // HWY_ONCE

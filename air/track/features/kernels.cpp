@@ -113,6 +113,9 @@ void SoftplusSums(const float* H, const float* h, size_t n, size_t M, size_t str
   }
 }
 
+// The target this copy was compiled for: dispatched like the kernels, it names the one they take.
+int64_t CompiledTarget() { return HWY_TARGET; }
+
 }  // namespace aerie::track::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -122,6 +125,7 @@ namespace aerie::track::kernels {
 HWY_EXPORT(FeaturesRun);
 HWY_EXPORT(AddLogRatio);
 HWY_EXPORT(SoftplusSums);
+HWY_EXPORT(CompiledTarget);
 
 void features_run(const ChannelImages& ch, const RectFeature* const* features, size_t nf, const SampleRun& run,
                   float* out, size_t stride) {
@@ -134,6 +138,7 @@ void add_log_ratio(const float* v, size_t n, float mu1, float sigma1, float mu0,
 void softplus_sums(const float* H, const float* h, size_t n, size_t M, size_t stride, double* S) {
   HWY_DYNAMIC_DISPATCH(SoftplusSums)(H, h, n, M, stride, S);
 }
+const char* target_name() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }
 
 }  // namespace aerie::track::kernels
 #endif

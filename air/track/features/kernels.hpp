@@ -28,4 +28,7 @@ void add_log_ratio(const float* v, size_t n, float mu1, float sigma1, float mu0,
 // none of the instances is positive (Algorithm 2, lines 8-10). M must be a multiple of 16.
 void softplus_sums(const float* H, const float* h, size_t n, size_t M, size_t stride, double* S);
 
+// Name of the instruction set these kernels dispatch to on this machine (e.g. "AVX2", "NEON").
+const char* target_name();
+
 }  // namespace aerie::track::kernels
