@@ -13,16 +13,9 @@
 #include "air/stereo/sgbm_ctf/sgm.hpp"
 #include "air/track/features/kernels.hpp"
 
-namespace {
+#include "tests/air/simd/cpu_targets.hpp"
 
-// Targets this CPU runs and the kernels were compiled for, best first (before any mock).
-std::vector<int64_t> cpu_targets() {
-  static const std::vector<int64_t> targets = [] {
-    hwy::SetSupportedTargetsForTest(0);
-    return hwy::SupportedAndGeneratedTargets();
-  }();
-  return targets;
-}
+namespace {
 
 std::string names(const std::vector<int64_t>& targets) {
   std::string s;

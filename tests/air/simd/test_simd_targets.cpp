@@ -23,18 +23,11 @@
 #include "air/track/features/rect_features.hpp"
 #include "air/track/features/samples.hpp"
 
+#include "tests/air/simd/cpu_targets.hpp"
+
 namespace {
 
-// Targets this CPU runs and the kernels were compiled for, best first (before any mock);
-// the scalar one is compared with itself too (it must be there: HWY_COMPILE_ALL_ATTAINABLE).
-std::vector<int64_t> cpu_targets() {
-  static const std::vector<int64_t> targets = [] {
-    hwy::SetSupportedTargetsForTest(0);
-    return hwy::SupportedAndGeneratedTargets();
-  }();
-  return targets;
-}
-
+// cpu_targets() includes the scalar target too (it must be there: HWY_COMPILE_ALL_ATTAINABLE).
 // Highway's portable path: EMU128 (or SCALAR where the compiler cannot build EMU128), the worst.
 int64_t scalar_target() { return cpu_targets().back(); }
 
