@@ -35,18 +35,49 @@ std::vector<double> yaml_doubles(const YAML::Node& root, const std::string& key,
   return v;
 }
 
-}  // namespace
-
-EurocCamera read_euroc_camera(const std::string& sensor_yaml) {
-  std::string text = read_text(sensor_yaml);
-  // EuRoC files start with OpenCV's "%YAML:1.0" directive, which yaml-cpp rejects.
-  if (text.rfind("%YAML:", 0) == 0) text = text.substr(text.find('\n') + 1);
+// A YAML file as OpenCV writes it (EuRoC's sensor.yaml, our stereo file), read with yaml-cpp:
+// OpenCV 4.6's own parser never returned on a 566-byte malformed file (fuzzing, docs/fuzz.md).
+// Its "%YAML:1.0" directive, which yaml-cpp rejects, is dropped; "!!opencv-matrix" tags are
+// ignored. The root must be a map.
+YAML::Node load_opencv_yaml(const std::string& path) {
+  std::string text = read_text(path);
+  if (text.rfind("%YAML:", 0) == 0) text = text.substr(std::min(text.size(), text.find('\n') + 1));
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    fail(sensor_yaml, std::string("YAML parse error: ") + e.what());
+    fail(path, std::string("YAML parse error: ") + e.what());
   }
+  if (!root.IsMap()) fail(path, "is not a map of fields");
+  return root;
+}
+
+// An OpenCV matrix node {rows, cols, dt, data}: rows x cols numbers, row-major, at most 64 (OpenCV
+// allocated what a corrupt `cols` declared, 48 GB, before reading the data).
+Eigen::MatrixXd opencv_matrix(const YAML::Node& root, const std::string& key, const std::string& file) {
+  const YAML::Node n = root[key];
+  if (!n) fail(file, "missing field '" + key + "'");
+  if (!n.IsMap()) fail(file, "field '" + key + "' is not a matrix (rows, cols, data)");
+  int rows = 0, cols = 0;
+  try {
+    rows = n["rows"].as<int>();
+    cols = n["cols"].as<int>();
+  } catch (const YAML::Exception&) {
+    fail(file, "field '" + key + "' needs integer rows and cols");
+  }
+  if (rows < 0 || cols < 0 || rows > 64 || cols > 64 || rows * cols > 64)
+    fail(file, "field '" + key + "' is not a small matrix");
+  if (rows * cols == 0) return Eigen::MatrixXd(rows, cols);  // e.g. no distortion coefficients
+  const auto data = yaml_doubles(n, "data", file + ": " + key, static_cast<size_t>(rows * cols));
+  Eigen::MatrixXd m(rows, cols);
+  for (int i = 0; i < rows * cols; ++i) m(i / cols, i % cols) = data[static_cast<size_t>(i)];
+  return m;
+}
+
+}  // namespace
+
+EurocCamera read_euroc_camera(const std::string& sensor_yaml) {
+  const YAML::Node root = load_opencv_yaml(sensor_yaml);
   EurocCamera cam;
   const std::string model = root["camera_model"] ? root["camera_model"].as<std::string>() : "";
   if (model != "pinhole") fail(sensor_yaml, "camera_model must be 'pinhole', got '" + model + "'");
@@ -135,83 +166,54 @@ StereoCalibration read_kitti_stereo(const std::string& calib_txt, int width, int
   return s;
 }
 
-namespace {
-
-StereoCalibration read_opencv_stereo_fields(const std::string& yaml) {
-  cv::FileStorage fsr;
-  try {
-    fsr.open(yaml, cv::FileStorage::READ);
-  } catch (const cv::Exception& e) {
-    fail(yaml, std::string("cannot parse: ") + e.what());
-  }
-  if (!fsr.isOpened()) fail(yaml, "cannot open file");
-  auto need = [&](const char* key) {
-    cv::FileNode n = fsr[key];
-    if (n.empty()) fail(yaml, std::string("missing field '") + key + "'");
-    return n;
-  };
-  // OpenCV allocates the rows x cols a matrix node declares before it reads the data (a corrupt
-  // `cols` asked for 48 GB): the size is checked first; a calibration matrix has at most 9 numbers.
-  auto matrix = [&](const cv::FileNode& n, const std::string& key) {
-    const double elements = n["rows"].real() * n["cols"].real();
-    if (!(elements >= 0 && elements <= 64)) fail(yaml, "field '" + key + "' is not a small matrix");
-    cv::Mat m;
-    n >> m;
-    return m;
+StereoCalibration read_opencv_stereo(const std::string& yaml) {
+  const YAML::Node root = load_opencv_yaml(yaml);
+  auto scalar = [&](const char* key) {
+    if (!root[key]) fail(yaml, std::string("missing field '") + key + "'");
+    try {
+      return root[key].as<int>();
+    } catch (const YAML::Exception&) {
+      fail(yaml, std::string("field '") + key + "' is not an integer");
+    }
   };
   StereoCalibration s;
   s.source = yaml;
-  const int w = static_cast<int>(need("width"));
-  const int h = static_cast<int>(need("height"));
+  const int w = scalar("width");
+  const int h = scalar("height");
   auto camera = [&](const std::string& side) {
     CameraModel c;
     c.width = w;
     c.height = h;
-    cv::Mat K = matrix(need((side + "_K").c_str()), side + "_K");
-    if (K.rows != 3 || K.cols != 3) fail(yaml, "field '" + side + "_K' must be a 3x3 matrix");
-    K.convertTo(K, CV_64F);
-    c.fx = K.at<double>(0, 0);
-    c.fy = K.at<double>(1, 1);
-    c.cx = K.at<double>(0, 2);
-    c.cy = K.at<double>(1, 2);
+    const Eigen::MatrixXd K = opencv_matrix(root, side + "_K", yaml);
+    if (K.rows() != 3 || K.cols() != 3) fail(yaml, "field '" + side + "_K' must be a 3x3 matrix");
+    c.fx = K(0, 0);
+    c.fy = K(1, 1);
+    c.cx = K(0, 2);
+    c.cy = K(1, 2);
     std::string model = "none";
-    if (!fsr[side + "_model"].empty()) fsr[side + "_model"] >> model;
-    c.distortion = distortion_from_string(model);
-    if (!fsr[side + "_D"].empty()) {
-      cv::Mat D = matrix(fsr[side + "_D"], side + "_D");
-      D.convertTo(D, CV_64F);
-      c.coeffs.assign(D.begin<double>(), D.end<double>());
+    if (root[side + "_model"]) {
+      try {
+        model = root[side + "_model"].as<std::string>();
+        c.distortion = distortion_from_string(model);
+      } catch (const std::exception&) {
+        fail(yaml, "field '" + side + "_model' is not a distortion model: '" + model + "'");
+      }
+    }
+    if (root[side + "_D"]) {
+      const Eigen::MatrixXd D = opencv_matrix(root, side + "_D", yaml);
+      c.coeffs.assign(D.data(), D.data() + D.size());
     }
     return c;
   };
   s.left = camera("left");
   s.right = camera("right");
-  cv::Mat R = matrix(need("R"), "R");
-  cv::Mat T = matrix(need("T"), "T");
-  if (R.rows != 3 || R.cols != 3) fail(yaml, "field 'R' must be a 3x3 matrix");
-  if (T.total() != 3) fail(yaml, "field 'T' must hold 3 numbers");
-  R.convertTo(R, CV_64F);
-  T.convertTo(T, CV_64F);
-  Eigen::Matrix3d Re;
-  for (int i = 0; i < 9; ++i) Re(i / 3, i % 3) = R.at<double>(i / 3, i % 3);
-  s.T_right_left = geometry::SE3(Re, Eigen::Vector3d(T.at<double>(0), T.at<double>(1), T.at<double>(2)));
+  const Eigen::MatrixXd R = opencv_matrix(root, "R", yaml);
+  const Eigen::MatrixXd T = opencv_matrix(root, "T", yaml);
+  if (R.rows() != 3 || R.cols() != 3) fail(yaml, "field 'R' must be a 3x3 matrix");
+  if (T.size() != 3) fail(yaml, "field 'T' must hold 3 numbers");
+  s.T_right_left = geometry::SE3(Eigen::Matrix3d(R), Eigen::Vector3d(T(0), T(1), T(2)));
   s.validate();
   return s;
-}
-
-}  // namespace
-
-StereoCalibration read_opencv_stereo(const std::string& yaml) {
-  // FileStorage throws cv::Exception on malformed content (a matrix without data or with a
-  // mistyped key, a list where a map belongs), and its parser lets std::length_error out of a
-  // corrupt file: refused like any other bad field.
-  try {
-    return read_opencv_stereo_fields(yaml);
-  } catch (const std::runtime_error&) {
-    throw;  // fail(): names the file and the field
-  } catch (const std::exception& e) {
-    fail(yaml, std::string("cannot read: ") + e.what());
-  }
 }
 
 void write_opencv_stereo(const StereoCalibration& c, const std::string& yaml) {
@@ -238,7 +240,7 @@ StereoCalibration read_stereo_calibration(const std::string& path, int width, in
   }
   const auto ext = p.extension().string();
   if (ext == ".txt") return read_kitti_stereo(path, width, height);
-  if (ext == ".yaml" || ext == ".yml" || ext == ".xml") return read_opencv_stereo(path);
+  if (ext == ".yaml" || ext == ".yml") return read_opencv_stereo(path);
   fail(path, "unknown calibration format (expected a EuRoC folder, a KITTI calib.txt or an OpenCV .yaml)");
 }
 

@@ -22,7 +22,7 @@ StereoCalibration read_euroc_stereo(const std::string& mav0_dir);
 // "P0:" labels). KITTI images are rectified: no distortion, R = I, baseline -P1[0,3]/fx.
 StereoCalibration read_kitti_stereo(const std::string& calib_txt, int width, int height);
 
-// Aerie's stereo calibration in OpenCV FileStorage YAML:
+// Aerie's stereo calibration in OpenCV FileStorage YAML (written by OpenCV, read with yaml-cpp):
 //   width, height, left_K (3x3), left_D, left_model, right_K, right_D, right_model,
 //   R (3x3), T (3x1): p_right = R * p_left + T (metres).
 StereoCalibration read_opencv_stereo(const std::string& yaml);

@@ -135,3 +135,32 @@ TEST(Rectification, EurocPairRowsAlignWithinHalfPixel) {
   EXPECT_NEAR(rect.rectified().baseline, 0.110, 0.001);
   EXPECT_THROW(rect.rectify(l_raw(cv::Rect(0, 0, 100, 100)), r_raw, l, r), std::invalid_argument);
 }
+
+TEST(Calibration, MalformedOpenCvYamlIsRefusedNotHung) {
+  // Fuzzing (fuzz/regressions/calibration/): OpenCV 4.6's FileStorage never returned on this
+  // 566-byte file, and allocated the 48 GB a corrupt `cols` declared. Read with yaml-cpp now.
+  for (const char* f : {"opencv_filestorage_open_hangs.yaml", "opencv_yaml_matrix_cols_garbage_48GB.yaml",
+                        "opencv_yaml_matrix_without_data.yaml", "opencv_yaml_not_a_map.yaml"}) {
+    const std::string path = std::string(AERIE_SOURCE_DIR) + "/fuzz/regressions/calibration/" + f;
+    try {
+      read_stereo_calibration(path);
+      ADD_FAILURE() << f << " was accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Calibration, OpenCvYamlWithoutDistortionRoundTrips) {
+  StereoCalibration c;
+  c.left = {376, 240, 300, 300, 188, 120, Distortion::None, {}};
+  c.right = c.left;
+  c.T_right_left = aerie::geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.11, 0, 0));
+  c.source = "test";
+  const auto file = aerie::test::scratch_dir("yaml") / "plain.yaml";
+  write_opencv_stereo(c, file);
+  const auto r = read_stereo_calibration(file);
+  EXPECT_EQ(r.left.distortion, Distortion::None);
+  for (double k : r.left.coeffs) EXPECT_EQ(k, 0.0);
+  EXPECT_NEAR(r.baseline(), 0.11, 1e-12);
+}
