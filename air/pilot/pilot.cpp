@@ -115,6 +115,7 @@ std::optional<Command> Pilot::on_clock(int64_t utime) {
   if (last_tick_ >= 0 && utime - last_tick_ < static_cast<int64_t>(cfg_.control_period_s * 1e6)) return std::nullopt;
   if (status_.state == State::Approach || status_.state == State::Descend) {
     resume_state_ = status_.state;
+    ++status_.stale_holds;
     enter(State::Hold, utime, "no tracker result for " + std::to_string((utime - last_track_) * 1e-6) + " s (stale)");
   }
   return tick(utime, false, TrackStatus::Idle);

@@ -91,6 +91,7 @@ struct PilotStatus {
   double yaw_error_deg = std::nan("");
   double height_m = std::nan("");
   int losses = 0, reacquisitions = 0;
+  int stale_holds = 0;  // HOLDs entered because the tracker fell silent (inputs stale)
 };
 
 class Pilot {

@@ -47,12 +47,9 @@ RunResult fly(const RunConfig& config) {
 
   RunResult r;
   std::map<int64_t, sim::TargetTruth> truth;  // of the last frames, by utime
-  bool descending = false, holding_stale = false;
+  bool descending = false;
   pilot_bus.subscribe<aerie::pilot_state_t>("PILOT_STATE", [&](const aerie::pilot_state_t& m, const bus::ReceiveInfo&) {
     descending = m.state == aerie::pilot_state_t::DESCEND;
-    const bool stale = m.state == aerie::pilot_state_t::HOLD && m.reason.find("(stale)") != std::string::npos;
-    r.pilot_stale_holds += stale && !holding_stale;
-    holding_stale = stale;
   }, 1000);
   pilot_bus.subscribe<aerie::target_pose_t>("TARGET_POSE", [&](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
     ++r.target_poses;
@@ -83,6 +80,7 @@ RunResult fly(const RunConfig& config) {
   r.final_state = pilot::state_name(pilot_node.pilot().state());
   r.losses = pilot_node.pilot().status().losses;
   r.reacquisitions = pilot_node.pilot().status().reacquisitions;
+  r.pilot_stale_holds = pilot_node.pilot().status().stale_holds;
   r.lockstep_timeouts = sim_node.lockstep_timeouts();
   r.pad_refined = track_node.counter("pad_refined");
   r.pad_not_found = track_node.counter("pad_not_found");

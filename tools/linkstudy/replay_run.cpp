@@ -15,10 +15,6 @@ namespace aerie::linkstudy {
 
 namespace {
 
-struct Box {
-  double x0, y0, x1, y1;
-};
-
 double iou(const Box& a, const Box& b) {
   const double w = std::max(0.0, std::min(a.x1, b.x1) - std::max(a.x0, b.x0));
   const double h = std::max(0.0, std::min(a.y1, b.y1) - std::max(a.y0, b.y0));
@@ -28,24 +24,26 @@ double iou(const Box& a, const Box& b) {
 
 }  // namespace
 
-ReplayResult replay(const ReplayConfig& config) {
-  // The log, by event time; the truth kept aside.
-  logio::Reader reader(config.log, logio::Reader::Options{.resync = true});
-  std::vector<logio::Event> events;
-  std::map<int64_t, Box> truth;  // visible GT_TRACK boxes by frame utime
-  int64_t frames = 0;
+std::shared_ptr<const Recording> load_recording(const std::string& path, const std::string& camera_channel,
+                                                const std::string& gt_channel) {
+  logio::Reader reader(path, logio::Reader::Options{.resync = true});
+  auto rec = std::make_shared<Recording>();
   for (logio::Event ev; reader.next(ev);) {
-    if (ev.channel == config.track.gt_channel) {
+    if (ev.channel == gt_channel) {
       const auto g = bus::decode_bounded<aerie::gt_box_t>(ev.data.data(), ev.data.size());
-      if (g.visible && g.width > 0 && g.height > 0) truth[g.utime] = {g.x, g.y, g.x + g.width, g.y + g.height};
+      if (g.visible && g.width > 0 && g.height > 0) rec->truth[g.utime] = {g.x, g.y, g.x + g.width, g.y + g.height};
     }
-    frames += ev.channel == config.track.camera_channel;
-    events.push_back(std::move(ev));
+    rec->frames += ev.channel == camera_channel;
+    rec->events.push_back(std::move(ev));
   }
-  if (frames == 0)
-    throw std::runtime_error(config.log + ": no frame on " + config.track.camera_channel + " to replay");
-  std::stable_sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.utime < b.utime; });
+  if (rec->frames == 0) throw std::runtime_error(path + ": no frame on " + camera_channel + " to replay");
+  std::stable_sort(rec->events.begin(), rec->events.end(), [](const auto& a, const auto& b) { return a.utime < b.utime; });
+  return rec;
+}
 
+ReplayResult replay(const ReplayConfig& config) {
+  const std::vector<logio::Event>& events = config.recording->events;
+  const std::map<int64_t, Box>& truth = config.recording->truth;
   link::SplitBus buses(config.split);
   buses.tap(config.on_message);
   track::NodeOptions to = config.track;
@@ -53,7 +51,7 @@ ReplayResult replay(const ReplayConfig& config) {
   track::TrackNode track_node(buses.of("track"), to);
 
   ReplayResult r;
-  r.frames = frames;
+  r.frames = config.recording->frames;
   std::map<int64_t, Box> seen;  // tracked boxes that reached the ground, by frame utime
   int64_t now = 0;
   buses.on(link::Side::kGround).subscribe<aerie::track_t>(to.track_channel, [&](const aerie::track_t& m, const bus::ReceiveInfo&) {

@@ -9,17 +9,36 @@
 //   frames lost    frames with the target visible for which no tracked box arrived.
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "air/track/node/track_node.hpp"
+#include "common/logio/event_log.hpp"
 #include "tools/link/sim_link.hpp"
 
 namespace aerie::linkstudy {
 
+struct Box {
+  double x0, y0, x1, y1;
+};
+
+// A recorded log, read once and shared (read-only) by the runs that replay it.
+struct Recording {
+  std::vector<logio::Event> events;  // by log time
+  std::map<int64_t, Box> truth;      // visible GT_TRACK boxes by frame utime
+  int64_t frames = 0;                // on the camera channel
+};
+
+// Reads an LCM log with the camera channel and GT_TRACK (e.g. aerie-bench-landing --log-dir);
+// throws std::runtime_error naming the log when it cannot be read or has no camera frame.
+std::shared_ptr<const Recording> load_recording(const std::string& path, const std::string& camera_channel,
+                                                const std::string& gt_channel);
+
 struct ReplayConfig {
-  std::string log;                 // an LCM log with the camera channel and GT_TRACK (e.g. aerie-bench-landing --log-dir)
+  std::shared_ptr<const Recording> recording;
   track::NodeOptions track;        // its camera channel is replayed; init_from_gt initialises it on GT_TRACK
   std::optional<link::Split> split;
   link::SplitBus::Tap on_message;  // every message on each side, with its simulation time
@@ -32,7 +51,6 @@ struct ReplayResult {
   double sim_s = 0;
 };
 
-// Throws std::runtime_error naming the log when it cannot be read or has no frame on the camera channel.
 ReplayResult replay(const ReplayConfig& config);
 
 }  // namespace aerie::linkstudy

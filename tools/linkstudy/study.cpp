@@ -15,7 +15,6 @@
 #include "common/logio/event_log.hpp"
 #include "common/sim/flight/flight_config.hpp"
 #include "tools/latency/stats.hpp"
-#include "tools/linkstudy/replay_run.hpp"
 
 namespace aerie::linkstudy {
 
@@ -253,14 +252,15 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
     if (!track::is_known_tracker(t)) fail("trackers", "unknown tracker '" + t + "'");
 
   const auto has = [&](Workload w) { return std::find(s.workloads.begin(), s.workloads.end(), w) != s.workloads.end(); };
-  if (has(Workload::kReplay)) {
-    if (!cfg.has("replay.log")) fail("replay.log", "the replay workload needs a recorded log (e.g. aerie-bench-landing --log-dir)");
-    s.replay_log = path(cfg.get<std::string>("replay.log", ""));
-    if (!std::filesystem::is_regular_file(s.replay_log)) fail("replay.log", "'" + s.replay_log + "' is not a file");
-  }
   if (has(Workload::kLanding) || has(Workload::kReplay)) {
     s.track_file = path(cfg.get<std::string>("landing.track", "config/track_landing.yaml"));
-    track::node_options(util::Config::load(s.track_file));  // refused now rather than in every run
+    const track::NodeOptions to = track::node_options(util::Config::load(s.track_file));  // refused now, not per run
+    if (has(Workload::kReplay)) {
+      if (!cfg.has("replay.log")) fail("replay.log", "the replay workload needs a recorded log (e.g. aerie-bench-landing --log-dir)");
+      const std::string log = path(cfg.get<std::string>("replay.log", ""));
+      if (!std::filesystem::is_regular_file(log)) fail("replay.log", "'" + log + "' is not a file");
+      s.replay = load_recording(log, to.camera_channel, to.gt_channel);  // once: every replay run shares it
+    }
   }
   if (has(Workload::kLanding)) {
     s.landing.sim = sim::load_flight_config(util::Config::load(path(cfg.get<std::string>("landing.sim", "config/sim/landing_room.yaml"))));
@@ -285,10 +285,8 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
 
 Crossing crossing(const StudyConfig& study, Workload w, const Placement& p) {
   const auto io = node_io(study, w);
-  auto side = [&](const std::string& node) {
-    const auto it = p.nodes.find(node);
-    return it == p.nodes.end() ? link::Side::kAir : it->second;
-  };
+  const link::Split where{p.nodes, {}, {}};
+  auto side = [&](const std::string& node) { return where.side(node); };
   std::set<std::string> read_on[2];  // by side
   for (const auto& n : io)
     for (const auto& c : n.in) read_on[static_cast<int>(side(n.node))].insert(c);
@@ -359,7 +357,7 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     row.wall_s = r.wall_s;
   } else if (spec.workload == Workload::kReplay) {
     ReplayConfig rc;
-    rc.log = study.replay_log;
+    rc.recording = study.replay;
     rc.track = track::node_options(util::Config::load(study.track_file));
     rc.track.tracker = spec.tracker;
     rc.track.seed = spec.seed;

@@ -5,12 +5,14 @@
 // link conditions, placements, workloads, trackers and seeds. One row per run.
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "common/util/config.hpp"
 #include "tools/avoidance/avoidance_run.hpp"
 #include "tools/latency/link_hops.hpp"
+#include "tools/linkstudy/replay_run.hpp"
 #include "tools/landing/landing_run.hpp"
 #include "tools/link/sim_link.hpp"
 
@@ -59,7 +61,7 @@ struct StudyConfig {
   // avoidance workload
   avoidance::RunConfig avoidance;
   // replay workload (open loop): a recorded log through the link; the tracker as landing.track says
-  std::string replay_log, replay_track_file;
+  std::shared_ptr<const Recording> replay;
 };
 
 // The built-in placements (docs/linkstudy.md):

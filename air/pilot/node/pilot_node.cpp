@@ -123,6 +123,7 @@ void PilotNode::report(bus::StatusReporter& status) const {
   for (const auto& [k, v] : counters_) status.set(k, v);
   const PilotStatus& s = pilot_.status();
   status.set("losses", s.losses);
+  status.set("stale_holds", s.stale_holds);
   status.set("reacquisitions", s.reacquisitions);
   const std::string msg = std::string(state_name(s.state)) + ": " + s.reason;
   if (s.state == State::Hold || s.state == State::Abort || s.state == State::Aborted)
