@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <sys/select.h>
@@ -63,6 +64,13 @@ Subscription& Bus::attach(std::unique_ptr<Subscription> sub, const std::string& 
   sub->handle_->setQueueCapacity(queue_capacity);
   subs_.push_back(std::move(sub));
   return *subs_.back();
+}
+
+void Bus::unsubscribe(const Subscription& sub) {
+  const auto it = std::find_if(subs_.begin(), subs_.end(), [&](const auto& s) { return s.get() == &sub; });
+  if (it == subs_.end()) throw std::invalid_argument("unsubscribe: " + sub.channel() + " is not a subscription of this bus");
+  if ((*it)->handle_) lcm_.unsubscribe((*it)->handle_);
+  subs_.erase(it);
 }
 
 int Bus::handle(int timeout_ms) {

@@ -119,6 +119,10 @@ class Bus {
     return attach(std::make_unique<RawSubscription>(std::move(handler)), channel_regex, queue_capacity);
   }
 
+  // Removes a subscription made on this bus (its handler is never called again, its
+  // queued messages are dropped). Not from inside a handler. Throws if it is not ours.
+  void unsubscribe(const Subscription& sub);
+
   // Handles messages for up to timeout_ms; returns how many were handled (0 on timeout).
   int handle(int timeout_ms);
   int fileno() { return lcm_.getFileno(); }

@@ -108,3 +108,23 @@ TEST(Bus, ChannelRegexWithAlternativesMatchesWholeNamesOnly) {
   }
   EXPECT_EQ(got, (std::vector<std::string>{"TRACK", "CAM_DOWN"}));
 }
+
+TEST(Bus, UnsubscribedHandlerIsNeverCalledAgain) {
+  // A node killed mid-flight (tools/faults) leaves the bus; the others keep their messages.
+  Bus bus("memq://");
+  int first = 0, second = 0;
+  auto& a = bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t&, const ReceiveInfo&) { ++first; });
+  bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t&, const ReceiveInfo&) { ++second; });
+  aerie::pose_t p{};
+  bus.publish("VO_POSE", p);
+  bus.unsubscribe(a);  // its queued message is dropped too
+  bus.publish("VO_POSE", p);
+  while (bus.handle(0) > 0) {
+  }
+  EXPECT_EQ(first, 0);
+  EXPECT_EQ(second, 2);
+  ASSERT_EQ(bus.subscriptions().size(), 1u);
+  Bus other("memq://");
+  auto& foreign = other.subscribe<aerie::pose_t>("VO_POSE", [](const aerie::pose_t&, const ReceiveInfo&) {});
+  EXPECT_THROW(bus.unsubscribe(foreign), std::invalid_argument);
+}
