@@ -56,6 +56,7 @@ void MultirotorParams::validate() const {
        "must be >= 0");
   need(takeoff_height_m > 0 && takeoff_speed_m_s > 0 && land_speed_m_s > 0, "take-off and landing figures must be > 0");
   need(radius_m > 0 && max_touchdown_speed_m_s > 0, "radius_m and max_touchdown_speed_m_s must be > 0");
+  need(command_timeout_s >= 0, "command_timeout_s must be >= 0 (0 = never)");
 }
 
 geometry::SE3 MultirotorState::pose() const {
@@ -86,6 +87,13 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind, double
     // A holding mode keeps the point where it began (a repeated one keeps the first).
     if (next.mode != active_.mode || !holds) hold_ = s_.position.head<2>() + odometry_error_;
     active_ = next;
+    active_since_s_ = t_s;
+  }
+  if (active_.mode == AutopilotCommand::Mode::Velocity && p_.command_timeout_s > 0 &&
+      t_s - active_since_s_ > p_.command_timeout_s + 1e-9) {
+    active_ = AutopilotCommand{};  // hover where it is
+    hold_ = s_.position.head<2>() + odometry_error_;
+    ++command_timeouts_;
   }
   std::normal_distribution<double> n01(0.0, 1.0);
   odometry_error_ += p_.hold_drift_m_per_sqrt_s * std::sqrt(dt) * Eigen::Vector2d(n01(rng_), n01(rng_));

@@ -43,6 +43,10 @@ struct MultirotorParams {
   double land_speed_m_s = 0.4;        // LAND descends at this speed
   double radius_m = 0.25;             // rotor tips from the centre: collision sphere
   double max_touchdown_speed_m_s = 1.0;  // faster vertical contact is a crash
+  // Offboard-loss failsafe: a VELOCITY command not renewed for this long is replaced by a
+  // position hold (PX4's COM_OF_LOSS_T, default 1 s), so a dead flight manager does not fly
+  // the vehicle on its last command. 0 = never.
+  double command_timeout_s = 1.0;
 
   // The two vehicle classes of docs/control.md, with the vertical loop and frame sizes.
   static MultirotorParams by_name(const std::string& name);  // "ardrone" | "pelican"; throws
@@ -90,6 +94,7 @@ class Multirotor {
   const MultirotorParams& params() const { return p_; }
   const AutopilotCommand& active_command() const { return active_; }
   double takeoff_z() const { return takeoff_z_; }
+  int64_t command_timeouts() const { return command_timeouts_; }  // offboard-loss holds
 
  private:
   MultirotorParams p_;
@@ -97,6 +102,8 @@ class Multirotor {
   std::deque<std::pair<double, AutopilotCommand>> pending_;  // (time it acts, command)
   AutopilotCommand active_;
   double takeoff_z_ = 0.0;
+  double active_since_s_ = 0.0;  // when the active command began to act
+  int64_t command_timeouts_ = 0;
   Eigen::Vector3d velocity_integral_ = Eigen::Vector3d::Zero();  // m/s^2
   Eigen::Vector2d hold_ = Eigen::Vector2d::Zero();                // HOVER/LAND position to hold
   Eigen::Vector2d odometry_error_ = Eigen::Vector2d::Zero();      // the autopilot's position estimate - truth

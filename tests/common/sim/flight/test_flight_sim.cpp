@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "common/sim/flight/flight_config.hpp"
 #include "common/sim/flight/flight_sim.hpp"
@@ -33,10 +34,14 @@ CommandInput mode(int m, double vx = 0, double vy = 0, double vz = 0, double yaw
 
 constexpr int kActive = 1, kTakeoff = 3, kLand = 4;
 
-// Steps until the simulated time reaches t (s).
-FlightFrame fly_until(FlightSim& sim, double t) {
+// Steps until the simulated time reaches t (s); with `renew`, sends it every frame as a
+// flight manager does (a velocity command not renewed becomes a hover after 1 s).
+FlightFrame fly_until(FlightSim& sim, double t, std::optional<CommandInput> renew = std::nullopt) {
   FlightFrame f = sim.step();
-  while (sim.time() < t - 1e-9 && !sim.outcome().collided) f = sim.step();
+  while (sim.time() < t - 1e-9 && !sim.outcome().collided) {
+    if (renew) sim.command(*renew);
+    f = sim.step();
+  }
   return f;
 }
 
@@ -123,8 +128,7 @@ TEST(FlightSim, FlyingIntoAWallIsACollisionNamedWithWhereItHappened) {
   sim.step();
   sim.command(mode(kTakeoff));
   fly_until(sim, 7.0);
-  sim.command(mode(kActive, 2.0));  // forward, whatever the heading: a wall is at most 8 m away
-  fly_until(sim, 30.0);
+  fly_until(sim, 30.0, mode(kActive, 2.0));  // forward, whatever the heading: a wall is at most 8 m away
   const FlightOutcome& o = sim.outcome();
   EXPECT_TRUE(o.collided);
   EXPECT_TRUE(o.ended());
@@ -137,8 +141,7 @@ TEST(FlightSim, BadCommandsAreRefusedWithAReasonAndTheVehicleHolds) {
   sim.step();
   sim.command(mode(kTakeoff));
   fly_until(sim, 7.0);
-  sim.command(mode(kActive, 0.8));  // moving forward ...
-  fly_until(sim, 9.0);
+  fly_until(sim, 9.0, mode(kActive, 0.8));  // moving forward ...
   ASSERT_GT(sim.vehicle().state().velocity.head<2>().norm(), 0.5);
   EXPECT_NE(sim.command(mode(kActive, std::nan(""))).find("not finite"), std::string::npos);
   EXPECT_NE(sim.command(mode(kActive, 0, 0, 0, 1e4)).find("yaw rate"), std::string::npos);

@@ -14,9 +14,11 @@ namespace {
 
 constexpr double kDt = 0.005;
 
-Multirotor airborne(MultirotorParams p = MultirotorParams::by_name("ardrone")) {
+// command_timeout_s 0: one command is held for as long as a test runs.
+Multirotor airborne(MultirotorParams p = MultirotorParams::by_name("ardrone"), double command_timeout_s = 0) {
   p.velocity_integral_per_s2 = 0;  // the pure first-order loops, to check their time constants
   p.hold_drift_m_per_sqrt_s = 0;
+  p.command_timeout_s = command_timeout_s;
   MultirotorState s;
   s.position = {0, 0, 2};
   s.armed = true;
@@ -59,6 +61,28 @@ TEST(Multirotor, PositiveYawRateTurnsClockwise) {
   run(m, t, 2.0);
   EXPECT_LT(m.state().yaw, 0.0);  // ENU yaw decreases when turning clockwise
   EXPECT_NEAR(m.state().yaw_rate, -30 * std::numbers::pi / 180, 0.01);
+}
+
+TEST(Multirotor, AVelocityCommandNotRenewedBecomesAHoverAfterTheTimeout) {
+  Multirotor m = airborne(MultirotorParams::by_name("ardrone"), 1.0);
+  const auto& p = m.params();
+  AutopilotCommand c;
+  c.mode = AutopilotCommand::Mode::Velocity;
+  c.velocity = {1.0, 0, 0};
+  double t = 0;
+  for (int i = 0; i < 40; ++i) {  // renewed at 20 Hz for 2 s: it flies
+    m.command(t, c);
+    run(m, t, 0.05);
+  }
+  EXPECT_GT(m.state().velocity.x(), 0.7);  // 1 m/s less the rotor drag
+  EXPECT_EQ(m.command_timeouts(), 0);
+  const double x_last = m.state().position.x();
+  run(m, t, 6.0);  // then silence (the flight manager died): a hover 1 s after the last command acted
+  EXPECT_EQ(m.command_timeouts(), 1);
+  EXPECT_EQ(m.active_command().mode, AutopilotCommand::Mode::Hover);
+  EXPECT_NEAR(m.state().velocity.norm(), 0.0, 0.02);
+  // It flew on for the timeout and the braking, not for the 6 s.
+  EXPECT_LT(m.state().position.x() - x_last, 1.0 * (p.base.command_delay_s + p.command_timeout_s) + 1.0);
 }
 
 TEST(Multirotor, TakeoffClimbsToItsHeightAndLandDisarmsOnContact) {
