@@ -51,7 +51,9 @@ NavConfig load_nav_config(const util::Config& cfg) {
       .known("camera")
       .known("vo")
       .known("outage")
+      .known("message_time")
       .finish();
+  out.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), out.message_time);
   e.gravity_m_s2 = top.gravity_m_s2;
   out.publish_rate_hz = top.publish_rate_hz;
   e.buffer_s = top.buffer_s;

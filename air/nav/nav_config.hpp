@@ -5,12 +5,17 @@
 
 #include "air/nav/eskf.hpp"
 #include "common/util/config.hpp"
+#include "common/util/message_clock.hpp"
 
 namespace aerie::nav {
 
 struct NavConfig {
   EskfParams eskf;
   double publish_rate_hz = 0.0;  // NAV_STATE rate in message time; 0 = every accepted IMU sample
+  // The node's message-time policy per source (the IMU; the VO's camera): a stamp more than
+  // 1 s from the newest is held, so one bogus stamp never moves the filter's clock
+  // (docs/architecture.md "Message time").
+  util::MessageClockConfig message_time{1'000'000, 3, 2'000'000};
 };
 
 NavConfig load_nav_config(const util::Config& cfg);

@@ -25,6 +25,7 @@
 
 #include "air/pilot/landing_control.hpp"
 #include "common/flc/flc.hpp"
+#include "common/util/message_clock.hpp"
 
 namespace aerie::pilot {
 
@@ -61,6 +62,10 @@ struct PilotConfig {
   double abort_climb_m_s = 0.5;
   double abort_climb_s = 1.5;
   double control_period_s = 0.05;    // ticks from the IMU clock while the tracker is silent
+  // The node's message-time policy per source (the tracker: TRACK and TARGET_POSE; the IMU):
+  // a message whose utime jumps by more than 1 s is held, so one bogus stamp never moves the
+  // state machine's clock (docs/architecture.md "Message time").
+  util::MessageClockConfig message_time{1'000'000, 3, 2'000'000};
   void validate() const;             // throws std::invalid_argument naming the field
 };
 

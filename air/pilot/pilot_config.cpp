@@ -34,7 +34,9 @@ PilotConfig load_pilot_config(const util::Config& cfg) {
       .known("hold")
       .known("abort")
       .known("gains")
+      .known("message_time")
       .finish();
+  p.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), p.message_time);
   const std::string rules = cfg.get<std::string>("fuzzy_rules", "");
   p.fuzzy_base = rules.empty() ? landing_flc() : flc::load_controller(rules);
 

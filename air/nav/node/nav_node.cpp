@@ -23,8 +23,14 @@ int8_t to_message(NavStatus s) {
 }  // namespace
 
 NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
-    : bus_(bus), cfg_(std::move(config)), opt_(std::move(options)), eskf_(cfg_.eskf) {
+    : bus_(bus),
+      cfg_(std::move(config)),
+      opt_(std::move(options)),
+      eskf_(cfg_.eskf),
+      imu_time_(opt_.imu_channel, cfg_.message_time),
+      vo_time_(opt_.vo_channel, cfg_.message_time) {
   bus_.subscribe<aerie::imu_t>(opt_.imu_channel, [this](const aerie::imu_t& m, const bus::ReceiveInfo&) {
+    if (!admit(imu_time_, opt_.imu_channel, m.utime)) return;
     ImuSample s;
     s.utime = m.utime;
     s.gyro = Vec3(m.angular_velocity[0], m.angular_velocity[1], m.angular_velocity[2]);
@@ -54,6 +60,7 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
       refused(opt_.vo_channel, "unknown pose status " + std::to_string(m.status));
       return;
     }
+    if (!admit(vo_time_, opt_.vo_channel, m.utime)) return;
     const double qn = std::sqrt(m.orientation[0] * m.orientation[0] + m.orientation[1] * m.orientation[1] +
                                 m.orientation[2] * m.orientation[2] + m.orientation[3] * m.orientation[3]);
     if (!std::isfinite(qn) || std::abs(qn - 1.0) > 1e-3) {
@@ -78,6 +85,16 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
     }
     ++counters_["vo"];
   });
+}
+
+bool NavNode::admit(util::MessageClock& clock, const std::string& channel, int64_t utime) {
+  // Staleness is the filter's own (outage.*, on message time): the node clock is not used.
+  const util::MessageClock::Result r = clock.observe(utime, 0);
+  if (r.verdict == util::MessageClock::Verdict::kResynced) spdlog::info("{}: {}", channel, r.reason);
+  if (r.accepted()) return true;
+  ++counters_[channel == opt_.imu_channel ? "imu_time_held" : "vo_time_held"];
+  refused(channel, r.reason);
+  return false;
 }
 
 void NavNode::refused(const std::string& what, const std::string& why) {

@@ -12,6 +12,7 @@
 #include "common/bus/bus.hpp"
 #include "common/bus/channels.hpp"
 #include "common/bus/status.hpp"
+#include "common/util/message_clock.hpp"
 
 namespace aerie::nav {
 
@@ -31,11 +32,14 @@ class NavNode {
  private:
   void publish();
   void refused(const std::string& what, const std::string& why);
+  // The message-time policy (NavConfig::message_time): false, counted and logged, for a held stamp.
+  bool admit(util::MessageClock& clock, const std::string& channel, int64_t utime);
 
   bus::Bus& bus_;
   NavConfig cfg_;
   NavNodeOptions opt_;
   Eskf eskf_;
+  util::MessageClock imu_time_, vo_time_;
   std::map<std::string, int64_t> counters_;
   std::map<std::string, int64_t> refusals_;  // per channel, for the log's throttle
   std::string last_error_;

@@ -11,8 +11,13 @@
 
 namespace aerie::pilot {
 
-PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options)
-    : bus_(bus), pilot_(std::move(config)), opt_(std::move(options)) {
+PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options, util::NodeClock now)
+    : bus_(bus),
+      pilot_(std::move(config)),
+      opt_(std::move(options)),
+      now_(std::move(now)),
+      track_time_("tracker", pilot_.config().message_time),
+      imu_time_(opt_.imu_channel, pilot_.config().message_time) {
   // Every handler turns a refused input into a counted error; the pilot keeps its state.
   auto guarded = [this](const std::string& what, auto&& fn) {
     try {
@@ -27,6 +32,7 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
     guarded(opt_.target_channel, [&] {
       if (m.source != aerie::target_pose_t::SOURCE_BOX && m.source != aerie::target_pose_t::SOURCE_FIT)
         throw std::invalid_argument("unknown target pose source " + std::to_string(m.source));
+      if (!on_time(track_time_, opt_.target_channel, m.utime)) return;
       pilot_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.yaw,
                         m.source == aerie::target_pose_t::SOURCE_FIT});
       count("targets");
@@ -36,12 +42,14 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
     guarded(opt_.track_channel, [&] {
       if (m.status < 0 || m.status > aerie::track_t::REDETECTED)
         throw std::invalid_argument("unknown track status " + std::to_string(m.status));
+      if (!on_time(track_time_, opt_.track_channel, m.utime)) return;
       count("tracks");
       publish(pilot_.on_track(m.utime, static_cast<TrackStatus>(m.status)));
     });
   });
   bus_.subscribe<aerie::imu_t>(opt_.imu_channel, [this, guarded](const aerie::imu_t& m, const bus::ReceiveInfo&) {
     guarded(opt_.imu_channel, [&] {
+      if (!on_time(imu_time_, opt_.imu_channel, m.utime)) return;
       if (m.orientation_valid)
         pilot_.on_attitude(m.utime, Eigen::Quaterniond(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]));
       if (const auto c = pilot_.on_clock(m.utime)) publish(*c);
@@ -54,8 +62,10 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
       spdlog::warn("{}", last_error_);
       return;
     }
+    // On the pilot's own time: the operator's stamp (another host's clock) never moves its clock.
+    const int64_t utime = imu_time_.synced() ? imu_time_.newest() : track_time_.synced() ? track_time_.newest() : m.utime;
     std::string why;
-    if (pilot_.on_operator(static_cast<Pilot::Operator>(m.command), m.utime, &why)) {
+    if (pilot_.on_operator(static_cast<Pilot::Operator>(m.command), utime, &why)) {
       count("operator_accepted");
       spdlog::info("operator command from '{}' accepted: {} ({})", m.source, state_name(pilot_.state()),
                    pilot_.status().reason);
@@ -65,6 +75,16 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
       spdlog::warn("{}", last_error_);
     }
   });
+}
+
+bool PilotNode::on_time(util::MessageClock& clock, const std::string& channel, int64_t utime) {
+  const util::MessageClock::Result r = clock.observe(utime, now_());
+  if (r.verdict == util::MessageClock::Verdict::kResynced) spdlog::info("{}: {}", channel, r.reason);
+  if (r.accepted()) return true;
+  count(channel + "_time_held");
+  last_error_ = channel + ": " + r.reason;
+  spdlog::warn("{}", last_error_);
+  return false;
 }
 
 void PilotNode::publish(const Command& c) {

@@ -14,6 +14,8 @@
 #include "air/pilot/pilot.hpp"
 #include "common/bus/bus.hpp"
 #include "common/bus/status.hpp"
+#include "common/util/message_clock.hpp"
+#include "common/util/time.hpp"
 
 namespace aerie::pilot {
 
@@ -28,7 +30,8 @@ struct PilotNodeOptions {
 
 class PilotNode {
  public:
-  PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options = {});
+  // `now` is the node's clock for the message-time policy (wall clock live; tests pass theirs).
+  PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options = {}, util::NodeClock now = util::wall_utime);
   void report(bus::StatusReporter& status) const;
   const Pilot& pilot() const { return pilot_; }
   int64_t counter(const std::string& name) const;
@@ -36,10 +39,14 @@ class PilotNode {
  private:
   void publish(const Command& c);
   void count(const std::string& name) { ++counters_[name]; }
+  // The message-time policy: false (counted "<channel>_time_held", logged) for a held stamp.
+  bool on_time(util::MessageClock& clock, const std::string& channel, int64_t utime);
 
   bus::Bus& bus_;
   Pilot pilot_;
   PilotNodeOptions opt_;
+  util::NodeClock now_;
+  util::MessageClock track_time_, imu_time_;
   std::map<std::string, int64_t> counters_;
   std::string last_error_;
   State last_state_ = State::Idle;
