@@ -128,6 +128,25 @@ TEST(NavNode, PublishRateLimitsNavState) {
   EXPECT_LT(n, 150);
 }
 
+TEST(NavNode, OneBogusImuStampIsHeldAndTheFilterGoesOn) {
+  // A corrupt or hostile IMU message stamped in the far future (fault campaign: it froze the
+  // filter, which then refused every real sample as "not after the previous one").
+  bus::Bus bus("memq://");
+  nav::NavNode node(bus, nav::load_nav_config(util::Config::load(AERIE_SOURCE_DIR "/config/nav.yaml")));
+  std::vector<aerie::nav_state_t> states;
+  bus.subscribe<aerie::nav_state_t>("NAV_STATE", [&](const aerie::nav_state_t& m, const bus::ReceiveInfo&) { states.push_back(m); });
+  int64_t t = 1'000'000;
+  for (int k = 0; k < 250; ++k) bus.publish("IMU", still_imu(t += 5000));
+  bus.publish("IMU", still_imu(t + (int64_t{1} << 50)));
+  for (int k = 0; k < 20; ++k) bus.publish("IMU", still_imu(t += 5000));
+  while (bus.handle(0) > 0) {
+  }
+  EXPECT_EQ(node.counter("imu_time_held"), 1);
+  EXPECT_EQ(node.counter("imu_refused"), 0);
+  ASSERT_EQ(states.size(), 270u);  // every real sample answered
+  EXPECT_EQ(states.back().utime, t);
+}
+
 TEST(NavConfig, FileDocumentsTheDefaultsAndIsStrict) {
   const nav::NavConfig file = nav::load_nav_config(util::Config::load(AERIE_SOURCE_DIR "/config/nav.yaml"));
   const nav::NavConfig defaults = nav::load_nav_config(util::Config());

@@ -1,6 +1,7 @@
 // aerie-pilot's node over memq://: one CTRL_CMD per TRACK with its utime, bad inputs counted
 // and dropped, operator commands applied or refused with a count.
 #include <aerie/control_cmd_t.hpp>
+#include <aerie/imu_t.hpp>
 #include <aerie/pilot_cmd_t.hpp>
 #include <aerie/target_pose_t.hpp>
 #include <aerie/track_t.hpp>
@@ -58,4 +59,44 @@ TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
   EXPECT_EQ(node.counter("operator_accepted"), 1);
   EXPECT_EQ(node.pilot().state(), pilot::State::Abort);
   EXPECT_EQ(cmds.size(), 3u);  // the bad TRACK made no command
+}
+
+TEST(PilotNode, OneBogusStampIsHeldAndNeverMovesItsClock) {
+  // A corrupt or hostile message stamped far from its source's time (fault campaign: a
+  // bit-flipped IMU stamp made the pilot see its tracker silent for 1.4e8 s and abort).
+  bus::Bus bus("memq://");
+  pilot::PilotNode node(bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml")));
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  auto drain = [&] {
+    while (bus.handle(0) > 0) {
+    }
+  };
+  aerie::track_t t{};
+  t.status = aerie::track_t::IDLE;
+  aerie::imu_t imu{};
+  imu.orientation_valid = true;
+  imu.orientation[0] = 1;
+  for (int k = 1; k <= 4; ++k) {
+    imu.utime = t.utime = k * 50000;
+    bus.publish("IMU", imu);
+    bus.publish("TRACK", t);
+    drain();
+  }
+  ASSERT_EQ(cmds.size(), 4u);
+  imu.utime = t.utime = 200000 + (int64_t{1} << 40);  // one high bit flipped in each
+  bus.publish("IMU", imu);
+  bus.publish("TRACK", t);
+  drain();
+  EXPECT_EQ(node.counter("IMU_time_held"), 1);
+  EXPECT_EQ(node.counter("TRACK_time_held"), 1);
+  EXPECT_EQ(cmds.size(), 4u);  // nothing answered the bogus TRACK, no stale tick from the bogus IMU
+  imu.utime = t.utime = 250000;
+  bus.publish("IMU", imu);
+  bus.publish("TRACK", t);
+  drain();
+  ASSERT_EQ(cmds.size(), 5u);
+  EXPECT_EQ(cmds.back().utime, 250000);
+  EXPECT_EQ(node.pilot().state(), pilot::State::Takeoff);
+  EXPECT_EQ(node.pilot().status().stale_holds, 0);
 }
