@@ -266,7 +266,12 @@ TEST(CaptureReplay, InterruptStopsCaptureCleanly) {
   Process capture({bin("aerie-capture"), "--lcm-url", "memq://", "--source", "kitti", "--path",
                    test::shared_data(kKitti).string(), "--rate", "1"},
                   dir / "capture.txt");
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // mid-sequence (5 s at real time)
+  // Once it runs (it says where it publishes after installing its handlers; start-up takes
+  // seconds on a loaded machine), then mid-sequence (5 s at real time).
+  for (int i = 0; i < 300 && slurp(dir / "capture.txt").find("-> memq://") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_NE(slurp(dir / "capture.txt").find("-> memq://"), std::string::npos) << slurp(dir / "capture.txt");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
   capture.signal(SIGINT);
   const auto rc = capture.wait(5);
   ASSERT_TRUE(rc) << "aerie-capture ignored SIGINT";
