@@ -85,20 +85,28 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
   switch (opt_.input) {
     case NodeOptions::Input::kVoPose:
       bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
-        if (m.status == aerie::pose_t::OK)
+        if (m.status == aerie::pose_t::OK) {
+          source_was_ok_ = true;
           on_pose(m.utime, m.orientation, m.position);
-        else
+        } else {
           status_.count("pose_not_ok");  // initialising/lost: no heading, the fallback takes over when stale
+          if (source_was_ok_ && m.status != aerie::pose_t::LOST)
+            refuse_mission(opt_.pose_channel + " restarted its frame (aerie-vo restarted or reset)");
+        }
         answer();
       });
       break;
     case NodeOptions::Input::kNavState:
       bus_.subscribe<aerie::nav_state_t>(opt_.pose_channel, [this](const aerie::nav_state_t& m, const bus::ReceiveInfo&) {
         // IMU_ONLY is the filter bridging a VO outage within its configured time: still flown on.
-        if (m.status == aerie::nav_state_t::OK || m.status == aerie::nav_state_t::IMU_ONLY)
+        if (m.status == aerie::nav_state_t::OK || m.status == aerie::nav_state_t::IMU_ONLY) {
+          source_was_ok_ = true;
           on_pose(m.utime, m.orientation, m.position);
-        else
+        } else {
           status_.count("nav_not_ok");  // initialising/lost
+          if (source_was_ok_ && m.status == aerie::nav_state_t::INITIALISING)
+            refuse_mission(opt_.pose_channel + " is initialising again: aerie-nav restarted, its frame is new");
+        }
         answer();
       });
       break;
@@ -142,6 +150,12 @@ void ControlNode::on_heading(int64_t utime, double heading_deg, const Eigen::Vec
   const auto time = pose_clock_.observe(utime, receive_us);
   if (!time.accepted()) return;
   if (time.verdict == util::MessageClock::Verdict::kResynced) loop_.resync();
+  const double from_origin = position.head<2>().norm();
+  if (!had_pose_ && opt_.input != NodeOptions::Input::kGtPose && loop_.config().activation_distance_m > 0 &&
+      from_origin > 0.5 * loop_.config().activation_distance_m)
+    refuse_mission("the first pose is " + std::to_string(from_origin) + " m from " + opt_.pose_channel +
+                   "'s origin: not the start of the manoeuvre (aerie-control restarted in flight?)");
+  had_pose_ = true;
   if (!loop_.on_heading(utime, heading_deg, receive_us, position)) {
     status_.count("pose_out_of_order");
     return;
@@ -165,7 +179,7 @@ void ControlNode::on_params(const aerie::flc_params_t& m) {
     return;
   }
   status_.count("params_accepted");
-  status_.ok("controller " + loop_.controller().id);
+  if (mission_refused_.empty()) status_.ok("controller " + loop_.controller().id);
   spdlog::info("controller '{}' in use ({} rules)", loop_.controller().id, loop_.controller().rules.size());
 }
 
@@ -176,8 +190,20 @@ void ControlNode::tick(int64_t now_us) {
   next_publish_ = now_us - next_publish_ > period_us_ ? now_us + period_us_ : next_publish_ + period_us_;
 }
 
+void ControlNode::refuse_mission(const std::string& why) {
+  if (!mission_refused_.empty()) return;
+  mission_refused_ = why;
+  status_.count("mission_refused");
+  status_.error("manoeuvre refused, hovering until the mission is restarted: " + why);
+  spdlog::error("manoeuvre refused, hovering until the mission is restarted: {}", why);
+}
+
 void ControlNode::publish_command(int64_t now_us) {
-  const Command c = loop_.command(now_us);
+  Command c = loop_.command(now_us);
+  if (!mission_refused_.empty()) {
+    c.mode = Mode::kFallbackHover;
+    c.yaw_rate_deg_s = c.forward_speed_m_s = 0.0;
+  }
   aerie::control_cmd_t m;
   m.utime = c.source_utime;
   m.seq = seq_++;

@@ -60,6 +60,12 @@ class ControlNode {
   void on_heading(int64_t utime, double heading_deg, const Eigen::Vector3d& position, int64_t receive_us);
   void answer();  // rate_hz 0: the command that follows an input message
   void on_params(const aerie::flc_params_t& m);
+  // The manoeuvre is defined from its start pose in the estimator's frame. It is refused for
+  // good — FALLBACK_HOVER, health ERROR, until the mission is restarted — when that frame is
+  // reset under it (the pose source initialising again: aerie-nav or aerie-vo restarted) or
+  // when the first pose is already away from the frame's origin (aerie-control restarted in
+  // mid-flight): a reference re-anchored there could steer into the wall.
+  void refuse_mission(const std::string& why);
 
   bus::Bus& bus_;
   bus::StatusReporter& status_;
@@ -69,6 +75,8 @@ class ControlNode {
   util::NodeClock now_;
   bus::InputClock pose_clock_;  // the message-time policy of the pose source
   int64_t bad_poses_ = 0;
+  bool source_was_ok_ = false, had_pose_ = false;
+  std::string mission_refused_;  // why, once refused
 };
 
 }  // namespace aerie::control

@@ -60,7 +60,8 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
       refused(opt_.vo_channel, "unknown pose status " + std::to_string(m.status));
       return;
     }
-    if (!admit(vo_time_, opt_.vo_channel, m.utime)) return;
+    const auto vo_time = admit(vo_time_, opt_.vo_channel, m.utime);
+    if (!vo_time) return;
     const double qn = std::sqrt(m.orientation[0] * m.orientation[0] + m.orientation[1] * m.orientation[1] +
                                 m.orientation[2] * m.orientation[2] + m.orientation[3] * m.orientation[3]);
     if (!std::isfinite(qn) || std::abs(qn - 1.0) > 1e-3) {
@@ -76,7 +77,9 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
     for (int i = 0; i < 36; ++i) C(i / 6, i % 6) = m.covariance[i];
     if (!C.isZero(0.0)) v.covariance = C;  // all zero (the VO's first frame): the configured noise
     // INITIALISING (first frame) and RESET: the VO (re)started its frame.
-    v.restart = m.status != aerie::pose_t::OK;
+    // A VO that came back at a new time (restarted: its INITIALISING pose may have been held
+    // as a jump) is a new frame too.
+    v.restart = m.status != aerie::pose_t::OK || *vo_time == util::MessageClock::Verdict::kResynced;
     const Outcome o = eskf_.add_vo(v);
     if (!o.accepted) {
       ++counters_["vo_refused"];
@@ -87,14 +90,15 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
   });
 }
 
-bool NavNode::admit(util::MessageClock& clock, const std::string& channel, int64_t utime) {
+std::optional<util::MessageClock::Verdict> NavNode::admit(util::MessageClock& clock, const std::string& channel,
+                                                          int64_t utime) {
   // Staleness is the filter's own (outage.*, on message time): the node clock is not used.
   const util::MessageClock::Result r = clock.observe(utime, 0);
   if (r.verdict == util::MessageClock::Verdict::kResynced) spdlog::info("{}: {}", channel, r.reason);
-  if (r.accepted()) return true;
+  if (r.accepted()) return r.verdict;
   ++counters_[channel == opt_.imu_channel ? "imu_time_held" : "vo_time_held"];
   refused(channel, r.reason);
-  return false;
+  return std::nullopt;
 }
 
 void NavNode::refused(const std::string& what, const std::string& why) {

@@ -5,6 +5,7 @@
 // filter never sees a malformed one.
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "air/nav/eskf.hpp"
@@ -32,8 +33,9 @@ class NavNode {
  private:
   void publish();
   void refused(const std::string& what, const std::string& why);
-  // The message-time policy (NavConfig::message_time): false, counted and logged, for a held stamp.
-  bool admit(util::MessageClock& clock, const std::string& channel, int64_t utime);
+  // The message-time policy (NavConfig::message_time): nullopt, counted and logged, for a held
+  // stamp; else the verdict (kResynced: the source restarted or came back after an outage).
+  std::optional<util::MessageClock::Verdict> admit(util::MessageClock& clock, const std::string& channel, int64_t utime);
 
   bus::Bus& bus_;
   NavConfig cfg_;

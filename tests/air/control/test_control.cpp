@@ -513,3 +513,43 @@ TEST(ControlNode, NavStateInputOneCommandPerMessage) {
   }
   EXPECT_TRUE(node.loop().turning());
 }
+
+TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
+  // The fault campaign (docs/faults.md): a respawned aerie-nav starts a new frame, a respawned
+  // aerie-control would re-anchor the manoeuvre where the vehicle is; both flew into the wall.
+  NodeOptions opt;
+  opt.input = NodeOptions::Input::kNavState;
+  opt.frame = default_heading_frame(opt.input);
+  opt.rate_hz = 0;
+  opt.control.forward_speed_m_s = 0.4;
+  opt.control.activation_distance_m = 1.0;
+  auto state = [](int64_t utime, int8_t status, double x) {
+    aerie::nav_state_t m{};
+    m.utime = utime;
+    m.status = status;
+    m.orientation[0] = 1;
+    m.position[0] = x;
+    return m;
+  };
+  for (const bool restarted_nav : {true, false}) {
+    bus::Bus bus("memq://");
+    bus::StatusReporter status(bus, "control");
+    int64_t now = 0;
+    ControlNode node(bus, status, tuned(), opt, [&now] { return now; });
+    std::vector<aerie::control_cmd_t> cmds;
+    bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+    // Nav restarted (OK, then INITIALISING, then OK in its new frame); or a control started
+    // in flight, its first pose 2 m from the frame's origin.
+    const double x0 = restarted_nav ? 0.0 : 2.0;
+    for (int k = 1; k <= 10; ++k) bus.publish("NAV_STATE", state(now = k * 5'000, aerie::nav_state_t::OK, x0 + 0.04 * k));
+    if (restarted_nav) bus.publish("NAV_STATE", state(now = 55'000, aerie::nav_state_t::INITIALISING, 0));
+    for (int k = 12; k <= 20; ++k) bus.publish("NAV_STATE", state(now = k * 5'000, aerie::nav_state_t::OK, 0.04 * k));
+    drain(bus);
+    ASSERT_EQ(cmds.size(), restarted_nav ? 20u : 19u) << restarted_nav;
+    EXPECT_EQ(cmds.front().mode, restarted_nav ? aerie::control_cmd_t::ACTIVE : aerie::control_cmd_t::FALLBACK_HOVER);
+    EXPECT_EQ(cmds.back().mode, aerie::control_cmd_t::FALLBACK_HOVER) << restarted_nav;  // for good
+    EXPECT_EQ(cmds.back().velocity_body[0], 0.0f);
+    EXPECT_EQ(cmds.back().yaw_rate_deg_s, 0.0f);
+    EXPECT_EQ(status.counter("mission_refused"), 1);
+  }
+}
