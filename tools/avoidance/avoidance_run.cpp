@@ -90,15 +90,19 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
 
   link::SplitBus buses(config.split);
   bus::Bus& air = buses.on(link::Side::kAir);
-  buses.tap(config.on_message);
+  faults::Injector injector(config.faults, seed);
+  buses.tap([&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
+    injector.observe(side, channel, data, size);
+    if (config.on_message) config.on_message(side, channel, data, size, now_us);
+  });
   sim::FlightSimNodeOptions so;
   so.answer_channels.clear();  // every node below answers on this thread: the buses settled = answered
   sim::FlightSimNode sim_node(air, simulator, so);
 
-  bus::Bus &vo_bus = buses.of("vo"), &control_bus = buses.of("control");
+  bus::Bus &vo_bus = buses.of("vo"), &nav_bus = buses.of("nav"), &control_bus = buses.of("control");
   bus::StatusReporter vo_status(vo_bus, "vo"), control_status(control_bus, "control");
-  std::unique_ptr<stereo::VoNode> vo_node;
-  std::unique_ptr<nav::NavNode> nav_node;
+  std::optional<faults::Respawnable<stereo::VoNode>> vo_node;
+  std::optional<faults::Respawnable<nav::NavNode>> nav_node;
   control::NodeOptions co = config.control;
   co.rate_hz = 0;  // one command per input: the frame's answer
   co.control.forward_speed_m_s = config.speed_m_s;
@@ -116,7 +120,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     stereo::VoNodeConfig vc = config.vo;
     vc.vo.ba_synchronous = true;
     vc.depth = "";
-    vo_node = std::make_unique<stereo::VoNode>(vo_bus, vo_status, vc, now);
+    vo_node.emplace(vo_bus, [&, vc] { return std::make_unique<stereo::VoNode>(vo_bus, vo_status, vc, now); });
   }
   if (config.source == Source::kVo) {
     // VO's world is its first left camera frame: the rig's up and forward, seen from the camera
@@ -125,8 +129,16 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     co.frame.up = R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
     co.frame.forward = R_body_cam.transpose() * Eigen::Vector3d::UnitX();
   }
-  if (config.source == Source::kVio) nav_node = std::make_unique<nav::NavNode>(buses.of("nav"), config.nav);
-  control::ControlNode control_node(control_bus, control_status, config.controller, co, now);
+  if (config.source == Source::kVio)
+    nav_node.emplace(nav_bus, [&] { return std::make_unique<nav::NavNode>(nav_bus, config.nav); });
+  faults::Respawnable<control::ControlNode> control_node(
+      control_bus, [&] { return std::make_unique<control::ControlNode>(control_bus, control_status, config.controller, co, now); });
+  faults::Flight flight;
+  flight.nodes["control"] = [&](bool alive) { alive ? control_node.start() : control_node.kill(); };
+  if (vo_node) flight.nodes["vo"] = [&](bool alive) { alive ? vo_node->start() : vo_node->kill(); };
+  if (nav_node) flight.nodes["nav"] = [&](bool alive) { alive ? nav_node->start() : nav_node->kill(); };
+  flight.stall_cameras = [&](bool stalled) { sim_node.stall_cameras(stalled); };
+  flight.buses = &buses;
 
   vo_bus.subscribe<aerie::pose_t>(config.vo.pose, [&](const aerie::pose_t& m, const bus::ReceiveInfo&) {
     ++r.vo_poses;
@@ -145,6 +157,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   int64_t est_n = 0;
   while (true) {
     const sim::FlightFrame& f = sim_node.publish_next();
+    injector.step(f.t, flight);
     buses.settle(f.utime);
     Sample s;
     s.t = f.t;
@@ -152,7 +165,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     s.travel_m = d.dot(ahead);
     s.lateral_m = d.dot(right);
     s.heading_deg = wrap180(-(f.vehicle.yaw - start.yaw) / kDeg);  // clockwise positive
-    s.turning = control_node.loop().turning();
+    s.turning = control_node.get() && control_node.get()->loop().turning();
     if (last_cmd.mode == aerie::control_cmd_t::ACTIVE) {
       if (!estimate_offset) estimate_offset = wrap180(last_cmd.heading_deg - s.heading_deg);
       s.estimate_deg = wrap180(last_cmd.heading_deg - *estimate_offset);
@@ -182,7 +195,8 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   r.heading_rmse_deg = settling.steady_rmse_deg();
   r.min_wall_distance_m = config.scene.wall_y_m - max_travel;
   if (est_n) r.estimate_rmse_deg = std::sqrt(est_sq / static_cast<double>(est_n));
-  if (nav_node) r.nav_gated = nav_node->filter().counters().vo_gated;
+  if (nav_node && nav_node->get()) r.nav_gated = nav_node->get()->filter().counters().vo_gated;
+  r.faults = injector.report(buses, sim_node.stalled_frames(), simulator.vehicle().command_timeouts());
   r.lockstep_timeouts = sim_node.lockstep_timeouts();
   r.commands_refused = simulator.commands_refused();
   r.link_down = buses.down_counters();

@@ -26,6 +26,7 @@
 #include "common/sim/flight/flight_sim.hpp"
 #include "common/sim/vehicle/avoidance.hpp"
 #include "common/util/config.hpp"
+#include "tools/faults/faults.hpp"
 #include "tools/link/sim_link.hpp"
 
 namespace aerie::avoidance {
@@ -49,6 +50,8 @@ struct RunConfig {
   // Sees every message on each side's bus in bus order, with the simulation time it is
   // handled at, e.g. to record it (the air side only without a split).
   link::SplitBus::Tap on_message;
+  // Injected during the flight (tools/faults): the nodes that run ("vo", "nav", "control") can be killed.
+  std::vector<faults::Fault> faults;
 };
 
 // config/avoidance.yaml: `sim:` (config/sim/landing_room.yaml's keys), `scene:`,
@@ -78,6 +81,7 @@ struct RunResult {
   double estimate_rmse_deg = std::nan("");  // heading estimate vs truth over the flight
   int64_t vo_poses = 0, vo_not_ok = 0, nav_gated = 0, commands_fallback = 0, lockstep_timeouts = 0, commands_refused = 0;
   link::DirectionCounters link_down, link_up;  // with a split
+  faults::Report faults;
   double sim_s = 0, wall_s = 0;
   std::vector<Sample> trajectory;
 };

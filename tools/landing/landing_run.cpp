@@ -35,15 +35,28 @@ RunResult fly(const RunConfig& config) {
   sim::FlightSim simulator(config.sim);
   link::SplitBus buses(config.split);
   bus::Bus& air = buses.on(link::Side::kAir);
-  buses.tap(config.on_message);
+  faults::Injector injector(config.faults, config.sim.seed);
+  buses.tap([&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
+    injector.observe(side, channel, data, size);
+    if (config.on_message) config.on_message(side, channel, data, size, now_us);
+  });
   sim::FlightSimNodeOptions so;
   so.answer_channels.clear();  // a frame is answered when the buses are settled
   sim::FlightSimNode sim_node(air, simulator, so);
   track::NodeOptions to = config.track;
   to.every_frame = true;  // lock-step: every frame delivered is tracked
-  track::TrackNode track_node(buses.of("track"), to);
-  bus::Bus& pilot_bus = buses.of("pilot");
-  pilot::PilotNode pilot_node(pilot_bus, config.pilot);
+  bus::Bus &track_bus = buses.of("track"), &pilot_bus = buses.of("pilot");
+  faults::Respawnable<track::TrackNode> track_node(track_bus, [&] { return std::make_unique<track::TrackNode>(track_bus, to); });
+  faults::Respawnable<pilot::PilotNode> pilot_node(pilot_bus, [&] { return std::make_unique<pilot::PilotNode>(pilot_bus, config.pilot); });
+  faults::Flight flight;
+  flight.nodes["track"] = [&](bool alive) { alive ? track_node.start() : track_node.kill(); };
+  flight.nodes["pilot"] = [&](bool alive) { alive ? pilot_node.start() : pilot_node.kill(); };
+  flight.stall_cameras = [&](bool stalled) { sim_node.stall_cameras(stalled); };
+  flight.buses = &buses;
+  auto wait_tracker = [&] {
+    if (track_node.get()) track_node.get()->wait_idle(60000);
+  };
+  auto pilot_state = [&] { return pilot_node.get() ? pilot_node.get()->pilot().state() : pilot::State::Idle; };
 
   RunResult r;
   std::map<int64_t, sim::TargetTruth> truth;  // of the last frames, by utime
@@ -67,28 +80,37 @@ RunResult fly(const RunConfig& config) {
     const sim::FlightFrame& f = sim_node.publish_next();
     truth[f.utime] = f.target;
     if (truth.size() > 400) truth.erase(truth.begin());  // 20 s at 20 Hz: longer than any link delay studied
-    buses.settle(f.utime, [&] { track_node.wait_idle(60000); });
+    injector.step(f.t, flight);
+    buses.settle(f.utime, wait_tracker);
     if (simulator.outcome().ended() && end_frame < 0) end_frame = f.seq;
-    const pilot::State s = pilot_node.pilot().state();
+    const pilot::State s = pilot_state();
     if (end_frame >= 0 && (s == pilot::State::Landed || s == pilot::State::Aborted ||
                            f.seq >= end_frame + config.frames_after_end))
       break;
   }
-  track_node.wait_idle(5000);
   r.outcome = simulator.outcome();
   r.score = sim::score_landing(simulator);
-  r.final_state = pilot::state_name(pilot_node.pilot().state());
-  r.losses = pilot_node.pilot().status().losses;
-  r.reacquisitions = pilot_node.pilot().status().reacquisitions;
-  r.pilot_stale_holds = pilot_node.pilot().status().stale_holds;
+  r.final_state = pilot::state_name(pilot_state());
+  r.dead_at_end = !track_node.get() || !pilot_node.get();
+  if (const pilot::PilotNode* p = pilot_node.get()) {
+    r.losses = p->pilot().status().losses;
+    r.reacquisitions = p->pilot().status().reacquisitions;
+    r.pilot_stale_holds = p->pilot().status().stale_holds;
+    for (const char* ch : {"TARGET_POSE", "TRACK", "IMU"})
+      r.pilot_refused += p->counter(std::string(ch) + "_refused") + p->counter(std::string(ch) + "_time_held");
+  }
   r.lockstep_timeouts = sim_node.lockstep_timeouts();
-  r.pad_refined = track_node.counter("pad_refined");
-  r.pad_not_found = track_node.counter("pad_not_found");
-  r.tracker_reseeded = track_node.counter("tracker_reseeded");
-  for (auto miss : {track::PadMiss::EmptyWindow, track::PadMiss::NoQuad, track::PadMiss::TouchesBorder,
-                    track::PadMiss::NoMarking, track::PadMiss::Reprojection})
-    if (const int64_t n = track_node.counter("pad_miss_" + track::to_string(miss)))
-      r.pad_misses += (r.pad_misses.empty() ? "" : " ") + track::to_string(miss) + ":" + std::to_string(n);
+  if (track::TrackNode* t = track_node.get()) {
+    t->wait_idle(5000);
+    r.pad_refined = t->counter("pad_refined");
+    r.pad_not_found = t->counter("pad_not_found");
+    r.tracker_reseeded = t->counter("tracker_reseeded");
+    for (auto miss : {track::PadMiss::EmptyWindow, track::PadMiss::NoQuad, track::PadMiss::TouchesBorder,
+                      track::PadMiss::NoMarking, track::PadMiss::Reprojection})
+      if (const int64_t n = t->counter("pad_miss_" + track::to_string(miss)))
+        r.pad_misses += (r.pad_misses.empty() ? "" : " ") + track::to_string(miss) + ":" + std::to_string(n);
+  }
+  r.faults = injector.report(buses, sim_node.stalled_frames(), simulator.vehicle().command_timeouts());
   r.commands_refused = simulator.commands_refused();
   r.link_down = buses.down_counters();
   r.link_up = buses.up_counters();

@@ -16,6 +16,7 @@
 #include "air/pilot/pilot.hpp"
 #include "air/track/node/track_node.hpp"
 #include "common/sim/flight/flight_sim.hpp"
+#include "tools/faults/faults.hpp"
 #include "tools/link/sim_link.hpp"
 
 namespace aerie::landing {
@@ -32,6 +33,8 @@ struct RunConfig {
   // Sees every message on each side's bus in bus order, with the simulation time it is
   // handled at, e.g. to record it (the air side only without a split).
   link::SplitBus::Tap on_message;
+  // Injected during the flight (tools/faults): nodes "track" and "pilot" can be killed.
+  std::vector<faults::Fault> faults;
 };
 
 // TARGET_POSE against the truth of its frame, during the pilot's DESCEND; fitted: the pad's
@@ -44,13 +47,16 @@ struct DescentSample {
 struct RunResult {
   sim::LandingScore score;
   sim::FlightOutcome outcome;
-  std::string final_state;         // the pilot's
+  std::string final_state;         // the pilot's (of its last incarnation)
   int losses = 0, reacquisitions = 0;
   int64_t pilot_stale_holds = 0;   // the pilot's HOLDs on stale inputs
   int64_t lockstep_timeouts = 0, target_poses = 0, commands_refused = 0;
-  int64_t pad_refined = 0, pad_not_found = 0, tracker_reseeded = 0;  // aerie-track's counters
+  int64_t pad_refined = 0, pad_not_found = 0, tracker_reseeded = 0;  // aerie-track's counters (last incarnation)
   std::string pad_misses;          // "reason:count ..." of the frames the pad was not found
   link::DirectionCounters link_down, link_up;  // with a split
+  faults::Report faults;
+  int64_t pilot_refused = 0;       // inputs the pilot refused: bad values, held time stamps (last incarnation)
+  bool dead_at_end = false;        // a node was dead when the flight ended
   double sim_s = 0, wall_s = 0;
   std::vector<DescentSample> descent;
   // 0..2: x, y, z (m); 3: yaw (deg); over every DESCEND sample or the fitted ones; NaN without samples

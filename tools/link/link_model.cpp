@@ -43,6 +43,7 @@ int64_t wire_bytes(const std::string& channel, size_t payload_size) {
 
 LinkDirection::LinkDirection(DirectionConfig config) : config_(std::move(config)) {
   config_.validate();
+  configured_ = config_;
   std::seed_seq loss_seed{config_.seed, uint64_t{1}}, delay_seed{config_.seed, uint64_t{2}};
   loss_rng_.seed(loss_seed);
   delay_rng_.seed(delay_seed);
@@ -87,6 +88,10 @@ void LinkDirection::transmit(int64_t now_us) {
     Packet sent = std::move(p);
     waiting_.pop_front();
     waiting_bytes_ -= bytes;
+    if (down_) {
+      ++counters_.dropped_outage;
+      continue;
+    }
     if (draw_loss()) {
       ++counters_.dropped_loss;
       continue;
@@ -123,6 +128,22 @@ void LinkDirection::offer(Packet packet, int64_t now_us) {
   waiting_bytes_ += bytes;
   waiting_.push_back(std::move(packet));
   transmit(now_us);
+}
+
+void LinkDirection::set_down(bool down) {
+  down_ = down;
+  if (!down_) return;
+  counters_.dropped_outage += static_cast<int64_t>(in_flight_.size());
+  in_flight_.clear();
+}
+
+void LinkDirection::impair(double delay_ms, double loss) {
+  DirectionConfig c = config_;
+  c.delay_ms = delay_ms;
+  c.loss_model = LossModel::Bernoulli;
+  c.loss = loss;
+  c.validate();
+  config_ = c;
 }
 
 std::vector<Packet> LinkDirection::due(int64_t now_us) {

@@ -76,6 +76,7 @@ struct DirectionCounters {
   int64_t dropped_loss = 0;
   int64_t dropped_queue = 0;
   int64_t dropped_other = 0;       // e.g. a single packet larger than the whole queue
+  int64_t dropped_outage = 0;      // sent or in flight while the link was down (faults)
   int64_t reencoded = 0;
 };
 
@@ -88,6 +89,14 @@ class LinkDirection {
   std::vector<Packet> due(int64_t now_us);
   // When something next happens (a transmission ends or a delivery is due); -1 = idle.
   int64_t next_event_us() const;
+
+  // Faults (tools/faults): while down, what is in flight and what is sent is lost; impair()
+  // sets the delay and a Bernoulli loss for what is sent from now on (throws on bad values),
+  // restore() the configured ones.
+  void set_down(bool down);
+  bool down() const { return down_; }
+  void impair(double delay_ms, double loss);
+  void restore() { config_ = configured_; }
 
   int queue_depth() const { return static_cast<int>(waiting_.size()); }
   int64_t queue_bytes() const { return waiting_bytes_; }
@@ -107,7 +116,7 @@ class LinkDirection {
     }
   };
 
-  DirectionConfig config_;
+  DirectionConfig config_, configured_;
   std::mt19937_64 loss_rng_, delay_rng_;  // separate streams: losses never shift delays
   std::deque<Packet> waiting_;
   int64_t waiting_bytes_ = 0;
@@ -116,6 +125,7 @@ class LinkDirection {
   int64_t last_release_us_ = 0;
   uint64_t next_serial_ = 0;
   bool bad_state_ = false;
+  bool down_ = false;
   DirectionCounters counters_;
 };
 

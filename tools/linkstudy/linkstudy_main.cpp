@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -61,12 +62,15 @@ int main(int argc, char** argv) {
     for (const auto& p : study.placements)
       for (const auto& t : w != linkstudy::Workload::kAvoidance ? study.trackers : std::vector<std::string>{"-"})
         for (const auto& [name, c] : conditions)
-          for (int i = 0; i < study.seeds; ++i)
-            specs.push_back({c, &p, w, t, study.first_seed + static_cast<uint64_t>(i)});
+          for (const auto& f : study.faults)
+            for (int i = 0; i < study.seeds; ++i)
+              specs.push_back({c, &p, w, t, study.first_seed + static_cast<uint64_t>(i), f});
   std::filesystem::create_directories(out_dir);
   if (logs) std::filesystem::create_directories(out_dir + "/logs");
-  std::printf("aerie-linkstudy: %zu flights (%zu conditions x %zu placements x workloads/trackers x %d seeds) on %d threads\n",
-              specs.size(), conditions.size(), study.placements.size(), study.seeds, jobs);
+  std::printf(
+      "aerie-linkstudy: %zu flights (%zu conditions x %zu placements x workloads/trackers x %zu fault scenarios x %d seeds) "
+      "on %d threads\n",
+      specs.size(), conditions.size(), study.placements.size(), study.faults.size(), study.seeds, jobs);
   std::fflush(stdout);
 
   bus::install_stop_handlers();
@@ -77,8 +81,12 @@ int main(int argc, char** argv) {
   util::parallel_for(static_cast<int>(specs.size()), jobs, [&](int i) {
     if (bus::stop_requested()) return;
     const auto& s = specs[static_cast<size_t>(i)];
-    const std::string run_name = std::string(linkstudy::workload_name(s.workload)) + "-" + s.placement->name + "-" +
-                                 s.tracker + "-" + s.condition->name() + "-seed" + std::to_string(s.seed);
+    std::string run_name = std::string(linkstudy::workload_name(s.workload)) + "-" + s.placement->name + "-" + s.tracker +
+                           "-" + s.condition->name() + "-seed" + std::to_string(s.seed);
+    if (study.faults.size() > 1 || s.faults != "none") {  // the scenario's index: specs are not file names
+      const auto f = std::find(study.faults.begin(), study.faults.end(), s.faults) - study.faults.begin();
+      run_name += "-fault" + std::to_string(f);
+    }
     try {
       auto row = linkstudy::run(study, s, logs ? out_dir + "/logs/" + run_name : "");
       std::lock_guard lk(out_mutex);

@@ -48,8 +48,8 @@ std::optional<double> breaking_point(const std::string& factor, const std::vecto
 
 void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
                   const std::vector<std::optional<RunRow>>& rows, const std::string& out_dir) {
-  // (workload, placement, tracker, condition) -> cell
-  using Key = std::tuple<int, std::string, std::string, std::string>;
+  // (workload, placement, tracker, condition, faults) -> cell
+  using Key = std::tuple<int, std::string, std::string, std::string, std::string>;
   std::map<Key, Cell> cells;
   double wall = 0, sim_s = 0;
   size_t flown = 0;
@@ -57,9 +57,14 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
     if (!rows[i]) continue;
     const RunSpec& s = specs[i];
     const RunRow& r = *rows[i];
-    Cell& c = cells[{static_cast<int>(s.workload), s.placement->name, s.tracker, s.condition->name()}];
+    Cell& c = cells[{static_cast<int>(s.workload), s.placement->name, s.tracker, s.condition->name(), s.faults}];
     ++c.runs;
     c.successes += r.success;
+    c.collisions += r.collision;
+    c.runs_fallback += r.pilot_stale_holds > 0 || r.control_fallbacks > 0;
+    c.runs_offboard_hold += r.faults.command_timeouts > 0;
+    c.malformed += static_cast<double>(r.faults.malformed);
+    ++c.final_states[r.final_state];
     if (r.value >= 0 && std::isfinite(r.value)) {
       c.metric_sum += r.value;
       ++c.metric_n;
@@ -108,7 +113,7 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
       for (size_t k = 0; k < sw.conditions.size() + 2; ++k) md << "---|";
       md << '\n';
       auto cell_of = [&](const Placement& p, const std::string& t, const Condition& c) {
-        const auto it = cells.find({static_cast<int>(w), p.name, t, c.name()});
+        const auto it = cells.find({static_cast<int>(w), p.name, t, c.name(), study.faults.front()});
         return it == cells.end() ? Cell{} : it->second;
       };
       for (const auto& p : study.placements)
@@ -163,6 +168,40 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
           md << " |\n";
         }
     }
+  }
+  if (study.faults.size() == 1 && study.faults.front() == "none") return;
+
+  // Faults (docs/faults.md): per placement and condition, each scenario's outcome.
+  std::map<std::string, const Condition*> conditions;
+  for (const Sweep& sw : study.sweeps)
+    for (const auto& c : sw.conditions) conditions.emplace(c.name(), &c);
+  for (Workload w : study.workloads) {
+    if (w == Workload::kReplay) continue;
+    const bool land = w == Workload::kLanding;
+    md << "\n## Faults in flight (" << workload_name(w) << ")\n\nSafe: no collision. Completed: "
+       << (land ? "landed on the pad (the landing's success)" : "turned along the wall without entering the danger zone")
+       << ". Fallback: runs in which " << (land ? "the pilot held on stale inputs" : "aerie-control hovered on stale inputs")
+       << "; offboard hold: runs in which the autopilot held because commands stopped (1 s). Malformed: messages the "
+          "decoders of the nodes alive at the end refused, per run.\n";
+    const std::vector<std::string> trackers = land ? study.trackers : std::vector<std::string>{"-"};
+    for (const auto& t : trackers)
+      for (const auto& p : study.placements)
+        for (const auto& [cname, c] : conditions) {
+          md << "\n### " << p.name << (land ? ", " + t : "") << ", link " << cname << "\n\n| faults | runs | safe | completed | "
+             << (land ? "touchdown error (cm)" : "heading RMSE (deg)")
+             << " | fallback | offboard hold | malformed / run | final states |\n|---|---|---|---|---|---|---|---|---|\n";
+          for (const auto& f : study.faults) {
+            const auto it = cells.find({static_cast<int>(w), p.name, t, cname, f});
+            if (it == cells.end()) continue;
+            const Cell& cell = it->second;
+            std::string states;
+            for (const auto& [s, n] : cell.final_states) states += (states.empty() ? "" : ", ") + s + " " + std::to_string(n);
+            md << "| `" << f << "` | " << cell.runs << " | " << cell.runs - cell.collisions << " | " << cell.successes << " | "
+               << (std::isfinite(cell.metric_mean()) ? fmt(land ? "%.1f" : "%.2f", (land ? 100 : 1) * cell.metric_mean()) : "—")
+               << " | " << cell.runs_fallback << " | " << cell.runs_offboard_hold << " | "
+               << fmt("%.0f", cell.malformed / cell.runs) << " | " << states << " |\n";
+          }
+        }
   }
 }
 

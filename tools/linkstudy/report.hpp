@@ -2,7 +2,10 @@
 // aerie-linkstudy's report (OUT/report.md): per workload and sweep, success and the error
 // metric against the swept factor, one line per placement and tracker; the factor value
 // at which success falls below 95 % and 50 %; the operator's view age; which stale-input
-// fallbacks fired; the link's traffic. The plots (plot_linkstudy.py) are linked from it.
+// fallbacks fired; the link's traffic. With fault scenarios, those tables are of the first
+// scenario, and a table per placement and condition says, per scenario, whether the vehicle
+// stayed safe, completed its mission and how it reacted. The plots (plot_linkstudy.py) are
+// linked from it.
 #include <map>
 #include <optional>
 #include <string>
@@ -12,9 +15,14 @@
 
 namespace aerie::linkstudy {
 
-// Aggregate of the runs of one (workload, placement, tracker, condition).
+// Aggregate of the runs of one (workload, placement, tracker, condition, fault scenario).
 struct Cell {
-  int runs = 0, successes = 0;
+  int runs = 0, successes = 0, collisions = 0;
+  // Runs in which a stale-input fallback fired (the pilot's HOLD, aerie-control's fallback
+  // hover), and in which the autopilot held because commands stopped.
+  int runs_fallback = 0, runs_offboard_hold = 0;
+  double malformed = 0;
+  std::map<std::string, int> final_states;
   double metric_sum = 0;
   int metric_n = 0;
   double age_p50_sum = 0, age_p95_sum = 0;

@@ -165,7 +165,8 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
   std::vector<std::string> known{"seeds.first", "seeds.count", "queue_bytes", "workloads", "trackers", "placements",
                                  "baseline.loss_model", "landing.sim", "landing.track", "landing.pilot",
                                  "landing.wind_m_s", "landing.vibration", "landing.max_time_s", "avoidance.config",
-                                 "avoidance.controller", "avoidance.source", "avoidance.speed_m_s", "replay.log"};
+                                 "avoidance.controller", "avoidance.source", "avoidance.speed_m_s", "replay.log",
+                                 "faults"};
   for (const Factor& f : kFactors) {
     known.push_back(std::string("baseline.") + f.key);
     known.push_back(std::string("sweeps.") + f.key + ".values");
@@ -252,6 +253,18 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
     if (!track::is_known_tracker(t)) fail("trackers", "unknown tracker '" + t + "'");
 
   const auto has = [&](Workload w) { return std::find(s.workloads.begin(), s.workloads.end(), w) != s.workloads.end(); };
+  s.faults = cfg.get<std::vector<std::string>>("faults", s.faults);
+  if (s.faults.empty()) fail("faults", "none given (leave the key out, or list \"none\" and the scenarios)");
+  for (const auto& f : s.faults) {
+    try {
+      const auto parsed = faults::parse_list(f);
+      faults::Injector check(parsed, 1);
+      if (!parsed.empty() && has(Workload::kReplay))
+        fail("faults", "faults are injected into closed-loop flights (landing, avoidance), not the replay; '" + f + "'");
+    } catch (const std::invalid_argument& e) {
+      fail("faults", e.what());
+    }
+  }
   if (has(Workload::kLanding) || has(Workload::kReplay)) {
     s.track_file = path(cfg.get<std::string>("landing.track", "config/track_landing.yaml"));
     const track::NodeOptions to = track::node_options(util::Config::load(s.track_file));  // refused now, not per run
@@ -338,6 +351,7 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     rc.track.seed = spec.seed;
     rc.split = split;
     rc.on_message = tap;
+    rc.faults = faults::parse_list(spec.faults);
     const landing::RunResult r = landing::fly(rc);
     row.success = r.score.success;
     row.collision = r.outcome.collided;
@@ -353,6 +367,7 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     row.down = r.link_down;
     row.up = r.link_up;
     row.final_state = r.final_state;
+    row.faults = r.faults;
     row.sim_s = r.sim_s;
     row.wall_s = r.wall_s;
   } else if (spec.workload == Workload::kReplay) {
@@ -382,6 +397,7 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     avoidance::RunConfig rc = study.avoidance;
     rc.split = split;
     rc.on_message = tap;
+    rc.faults = faults::parse_list(spec.faults);
     const avoidance::RunResult r = avoidance::fly(rc, spec.seed);
     row.collision = r.collided;
     row.entered_danger = r.entered_danger;
@@ -393,6 +409,7 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     row.down = r.link_down;
     row.up = r.link_up;
     row.final_state = r.completed ? "completed" : r.collided ? "collided" : r.timed_out ? "timed_out" : "ended";
+    row.faults = r.faults;
     row.sim_s = r.sim_s;
     row.wall_s = r.wall_s;
   }
@@ -414,7 +431,9 @@ std::string csv_header() {
          "sweep,jitter_ms,loss_model,burst_length,jpeg_quality,collision,touchdown_error_m,yaw_error_deg,time_s,losses,"
          "target_rmse_xy_m,heading_rmse_deg,entered_danger,mean_iou,centre_error_px,frames_visible,frames_lost,view_age_p50_ms,view_age_p95_ms,view_messages,"
          "pilot_stale_holds,control_fallbacks,down_received,down_delivered,down_lost,down_queue_dropped,"
-         "up_received,up_delivered,up_lost,up_queue_dropped,down_kbit_s,up_kbit_s,final_state,sim_s";
+         "up_received,up_delivered,up_lost,up_queue_dropped,down_kbit_s,up_kbit_s,final_state,sim_s,"
+         "faults,faults_applied,command_timeouts,camera_stalled_frames,malformed,burst_messages,nan_messages,kills,"
+         "respawns,down_outage_dropped,up_outage_dropped";
 }
 
 std::string csv_row(const std::string& sweep, const RunSpec& spec, const RunRow& r) {
@@ -431,7 +450,11 @@ std::string csv_row(const std::string& sweep, const RunSpec& spec, const RunRow&
     << r.view_age_p95_ms << ',' << r.view_messages << ',' << r.pilot_stale_holds << ',' << r.control_fallbacks << ','
     << r.down.received << ',' << r.down.delivered << ',' << r.down.dropped_loss << ',' << r.down.dropped_queue << ','
     << r.up.received << ',' << r.up.delivered << ',' << r.up.dropped_loss << ',' << r.up.dropped_queue << ','
-    << r.down_kbit_s << ',' << r.up_kbit_s << ',' << r.final_state << ',' << r.sim_s;
+    << r.down_kbit_s << ',' << r.up_kbit_s << ',' << r.final_state << ',' << r.sim_s << ',' << spec.faults << ','
+    << r.faults.applied << ',' << r.faults.command_timeouts << ',' << r.faults.stalled_frames << ',' << r.faults.malformed
+    << ',' << r.faults.counters.burst_messages << ',' << r.faults.counters.nan_messages << ',' << r.faults.counters.kills
+    << ',' << r.faults.counters.respawns << ','
+    << r.down.dropped_outage << ',' << r.up.dropped_outage;
   return o.str();
 }
 

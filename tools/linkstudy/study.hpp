@@ -52,6 +52,9 @@ struct StudyConfig {
   std::vector<Placement> placements;
   std::vector<Workload> workloads;
   std::vector<std::string> trackers{"amcmr-ct"};  // landing and replay workloads
+  // Fault scenarios (tools/faults, docs/faults.md), each one or more specs separated by
+  // spaces; "none" flies without a fault. Closed-loop workloads (landing, avoidance) only.
+  std::vector<std::string> faults{"none"};
   uint64_t first_seed = 1;
   int seeds = 3;
   int64_t queue_bytes = 262144;    // the radio's buffer per direction
@@ -91,6 +94,7 @@ struct RunSpec {
   Workload workload = Workload::kLanding;
   std::string tracker;             // "-" for avoidance
   uint64_t seed = 1;
+  std::string faults = "none";     // the fault scenario
 };
 
 struct RunRow {
@@ -111,6 +115,7 @@ struct RunRow {
   std::vector<latency::LinkHop> hops;  // the air and ground logs joined (aerie-latency AIR GROUND)
   double down_kbit_s = 0, up_kbit_s = 0;  // delivered wire bytes per simulated second
   std::string final_state;
+  faults::Report faults;           // landing, avoidance: what the flight saw of its faults
   double sim_s = 0, wall_s = 0;
 };
 

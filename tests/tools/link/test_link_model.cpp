@@ -278,3 +278,28 @@ TEST(LinkModel, InvalidSettingsNameTheField) {
   EXPECT_THROW(queue_policy_from_string("oldest"), std::invalid_argument);
   EXPECT_THROW(loss_model_from_string("ge"), std::invalid_argument);
 }
+
+TEST(LinkModel, ADownLinkLosesWhatIsInFlightAndWhatIsSentThenImpairmentApplies) {
+  DirectionConfig c;
+  c.delay_ms = 100;
+  LinkDirection d(c);
+  std::vector<Packet> got;
+  // 0..9 ms: 10 packets in flight; down at 50 ms (nothing delivered yet): all lost.
+  for (int i = 0; i < 10; ++i) d.offer(packet(), i * 1000);
+  d.set_down(true);
+  for (int i = 0; i < 5; ++i) d.offer(packet(), 60000 + i * 1000);
+  for (auto& p : d.due(400000)) got.push_back(std::move(p));
+  EXPECT_TRUE(got.empty());
+  EXPECT_EQ(d.counters().dropped_outage, 15);
+  // Up again, at 500 ms delay and 30 % loss.
+  d.set_down(false);
+  d.impair(500, 0.3);
+  for (int i = 0; i < 2000; ++i) d.offer(packet(), 500000 + i * 1000);
+  for (auto& p : d.due(3000000)) {
+    EXPECT_EQ(p.release_us - p.arrival_us, 500000);
+    got.push_back(std::move(p));
+  }
+  EXPECT_NEAR(static_cast<double>(got.size()) / 2000.0, 0.7, 0.04);
+  EXPECT_EQ(d.counters().dropped_outage, 15);
+  EXPECT_THROW(d.impair(500, 1.5), std::invalid_argument);
+}

@@ -128,6 +128,10 @@ const FlightFrame& FlightSimNode::publish_next() {
     s.lockstep_timeouts = timeouts_;
     bus_.publish(opt_.state_channel, s);
   }
+  if (cameras_stalled_) {  // a stalled camera driver: the rest of the frame goes out
+    ++stalled_frames_;
+    return frame_;
+  }
   if (f.stereo && !opt_.stereo_channel.empty()) {
     const Intrinsics K = sim_.stereo_intrinsics();
     aerie::stereo_image_t s{};

@@ -52,6 +52,9 @@ class FlightSimNode {
   const FlightFrame& last() const { return frame_; }
   int64_t lockstep_timeouts() const { return timeouts_; }
   int64_t commands_received() const { return commands_; }
+  // Faults (tools/faults): while stalled, frames publish no images (IMU and truth go on).
+  void stall_cameras(bool stalled) { cameras_stalled_ = stalled; }
+  int64_t stalled_frames() const { return stalled_frames_; }
 
  private:
   void on_command(const aerie::control_cmd_t& cmd);
@@ -61,7 +64,8 @@ class FlightSimNode {
   FlightSimNodeOptions opt_;
   FlightFrame frame_;
   std::map<std::string, int64_t> answered_;  // newest utime per answer channel
-  int64_t timeouts_ = 0, commands_ = 0, imu_seq_ = 0;
+  int64_t timeouts_ = 0, commands_ = 0, imu_seq_ = 0, stalled_frames_ = 0;
+  bool cameras_stalled_ = false;
 };
 
 }  // namespace aerie::sim
