@@ -99,12 +99,15 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
     case NodeOptions::Input::kNavState:
       bus_.subscribe<aerie::nav_state_t>(opt_.pose_channel, [this](const aerie::nav_state_t& m, const bus::ReceiveInfo&) {
         // IMU_ONLY is the filter bridging a VO outage within its configured time: still flown on.
+        // A restarted aerie-nav initialises for its whole alignment window (200 messages at 1 s
+        // and 200 Hz); one message saying so is a corrupt one, not a restart.
+        initialising_run_ = m.status == aerie::nav_state_t::INITIALISING ? initialising_run_ + 1 : 0;
         if (m.status == aerie::nav_state_t::OK || m.status == aerie::nav_state_t::IMU_ONLY) {
           source_was_ok_ = true;
           on_pose(m.utime, m.orientation, m.position);
         } else {
           status_.count("nav_not_ok");  // initialising/lost
-          if (source_was_ok_ && m.status == aerie::nav_state_t::INITIALISING)
+          if (source_was_ok_ && initialising_run_ >= kNavRestartMessages)
             refuse_mission(opt_.pose_channel + " is initialising again: aerie-nav restarted, its frame is new");
         }
         answer();

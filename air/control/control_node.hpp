@@ -76,6 +76,8 @@ class ControlNode {
   bus::InputClock pose_clock_;  // the message-time policy of the pose source
   int64_t bad_poses_ = 0;
   bool source_was_ok_ = false, had_pose_ = false;
+  static constexpr int kNavRestartMessages = 3;  // INITIALISING in a row after OK: a restart
+  int initialising_run_ = 0;
   std::string mission_refused_;  // why, once refused
 };
 

@@ -542,11 +542,16 @@ TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
     // in flight, its first pose 2 m from the frame's origin.
     const double x0 = restarted_nav ? 0.0 : 2.0;
     for (int k = 1; k <= 10; ++k) bus.publish("NAV_STATE", state(now = k * 5'000, aerie::nav_state_t::OK, x0 + 0.04 * k));
-    if (restarted_nav) bus.publish("NAV_STATE", state(now = 55'000, aerie::nav_state_t::INITIALISING, 0));
+    if (restarted_nav) {
+      bus.publish("NAV_STATE", state(now = 50'500, aerie::nav_state_t::INITIALISING, 0));  // one alone: corrupt
+      bus.publish("NAV_STATE", state(now = 51'000, aerie::nav_state_t::OK, 0.41));
+      for (int k = 0; k < 3; ++k) bus.publish("NAV_STATE", state(now = 52'000 + 1'000 * k, aerie::nav_state_t::INITIALISING, 0));
+    }
     for (int k = 12; k <= 20; ++k) bus.publish("NAV_STATE", state(now = k * 5'000, aerie::nav_state_t::OK, 0.04 * k));
     drain(bus);
-    ASSERT_EQ(cmds.size(), restarted_nav ? 20u : 19u) << restarted_nav;
+    ASSERT_EQ(cmds.size(), restarted_nav ? 24u : 19u) << restarted_nav;
     EXPECT_EQ(cmds.front().mode, restarted_nav ? aerie::control_cmd_t::ACTIVE : aerie::control_cmd_t::FALLBACK_HOVER);
+    if (restarted_nav) EXPECT_EQ(cmds[11].mode, aerie::control_cmd_t::ACTIVE);  // after the lone INITIALISING
     EXPECT_EQ(cmds.back().mode, aerie::control_cmd_t::FALLBACK_HOVER) << restarted_nav;  // for good
     EXPECT_EQ(cmds.back().velocity_body[0], 0.0f);
     EXPECT_EQ(cmds.back().yaw_rate_deg_s, 0.0f);
