@@ -25,22 +25,9 @@ bash scripts/build.sh
 BIN=build/default/bin
 
 # --- LCM on this host: UDP multicast that never leaves it (ttl=0) -----------------
-export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0'
-if ! ip route show 224.0.0.0/4 2>/dev/null | grep -q .; then
-  if [ "$(id -u)" -eq 0 ]; then
-    ip route add 224.0.0.0/4 dev lo
-    echo "demo: added the multicast route 224.0.0.0/4 on lo (ip route add 224.0.0.0/4 dev lo)"
-  else
-    echo "demo: no multicast route; as root run: ip route add 224.0.0.0/4 dev lo" >&2
-  fi
-fi
-# lcm-logger and the nodes need large socket buffers: stereo frames arrive as bursts of
-# fragments that overflow the kernel default (docs/logs.md).
-rmem_max=$(sysctl -n net.core.rmem_max 2>/dev/null || echo 0)
-if [ "$rmem_max" -lt 4194304 ] && [ "$(id -u)" -eq 0 ]; then
-  sysctl -q -w net.core.rmem_max=4194304
-  echo "demo: raised net.core.rmem_max from $rmem_max to 4194304 (UDP receive buffers for images)"
-fi
+# (the multicast route on lo and 4 MiB receive buffers, as root: scripts/local-lcm.sh)
+source scripts/local-lcm.sh
+aerie_local_lcm demo
 
 # --- What the deputy expands in config/demo.pmd ------------------------------------
 mkdir -p logs
@@ -48,12 +35,7 @@ stem="logs/demo-$(date +%Y%m%d-%H%M%S)"
 export AERIE_LOG="$stem.lcm" AERIE_MAP="$stem-map.bt" AERIE_RESULT="$stem-result.txt"
 export AERIE_SNAPSHOT="$stem-dashboard.png" AERIE_SEED="$seed"
 # The viewer renders off-screen but needs an X server: a private Xvfb unless one is set.
-xvfb_pid=""
-if [ -z "${DISPLAY:-}" ]; then
-  export DISPLAY=:$((90 + RANDOM % 100))
-  Xvfb "$DISPLAY" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
-  xvfb_pid=$!
-fi
+aerie_start_xvfb
 
 deputy_pid=""
 cleanup() {
