@@ -79,8 +79,17 @@ TEST(LinkStudy, BadStudyIsRefusedNamingTheField) {
 }
 
 TEST(LinkStudy, ShippedStudiesLoad) {
-  for (const char* f : {"/config/linkstudy/quick.yaml", "/config/linkstudy/placements.yaml", "/config/linkstudy/delay_edge.yaml"})
+  for (const char* f : {"/config/linkstudy/quick.yaml", "/config/linkstudy/placements.yaml", "/config/linkstudy/delay_edge.yaml",
+                        "/config/linkstudy/faults.yaml", "/config/linkstudy/faults_avoidance.yaml",
+                        "/config/linkstudy/faults_link.yaml"})
     EXPECT_NO_THROW(linkstudy::load_study(util::Config::load(kSource + f), kSource)) << f;
+  // A fault scenario is refused naming what is wrong in it.
+  try {
+    linkstudy::load_study(util::Config::parse(std::string(kStudy) + "faults: [none, \"kill:track@8\"]\n", "study.yaml"), kSource);
+    ADD_FAILURE() << "a kill without a duration was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("faults: fault 'kill:track@8': kill needs a duration"), std::string::npos) << e.what();
+  }
   // trackers.yaml replays a landing recorded under logs/ (the file says how): until it is, that is what it says.
   try {
     linkstudy::load_study(util::Config::load(kSource + "/config/linkstudy/trackers.yaml"), kSource);
