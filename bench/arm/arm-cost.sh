@@ -1,19 +1,19 @@
 #!/usr/bin/env bash
 # What the air side costs on a board (issue 16 §3): instructions retired per frame of each
-# air-side node's work, counted with a QEMU instruction-count plugin (tools/insncount) under
+# air-side node's work, counted with a QEMU instruction-count plugin (bench/arm) under
 # qemu-user for arm64 and armhf and under qemu-x86_64 for x86, the heap the node takes, and
 # (x86, natively) the peak RSS and CPU time per frame. Method: docs/arm.md ("What it costs on a
 # board"); figures: docs/results/arm.md.
 set -euo pipefail
 
-root=$(cd "$(dirname "$0")/.." && pwd)
+root=$(cd "$(dirname "$0")/../.." && pwd)
 usage() {
   cat <<'EOF'
-usage: scripts/arm-cost.sh [options]
+usage: bench/arm/arm-cost.sh [options]
 
 Counts the instructions each air-side node retires per frame. Every case runs twice, with N1
-and N2 frames (the same frames prepared in both runs), under qemu-user with the plugin
-tools/insncount; per frame = (count(N2) - count(N1)) / (N2 - N1), so start-up, library
+and N2 frames (the same frames prepared in both runs), under qemu-user with the plugin of
+bench/arm (insncount.c); per frame = (count(N2) - count(N1)) / (N2 - N1), so start-up, library
 loading and reading the data cancel. Also: the node's heap (glibc mallinfo2 inside the
 program, so the target's own), qemu's max RSS, and on x86 native runs (max RSS, CPU s/frame).
 
@@ -65,7 +65,7 @@ T=$data/tracking
 EUROC=$data/stereo_seq/EuRoC_V1_01_easy_f000-094
 KITTI=$data/stereo_seq/KITTI_odom_06_f000-050
 
-# Cases: name | binary (capture = the aerie-capture node itself, cost = tools/insncount's
+# Cases: name | binary (capture = the aerie-capture node itself, cost = bench/arm's
 # driver) | N1 | N2 | quick N1 | quick N2 | arguments ({N}: frames, {P}: frames prepared).
 # 376x240 is the thesis' resolution (the EuRoC camera halved); "native" is the data's own size.
 cases=(
@@ -124,7 +124,7 @@ echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ /
 
 # ---- build ----
 plugin_dir=$root/build/insncount
-"$root/tools/insncount/build.sh" "$plugin_dir" >/dev/null
+"$root/bench/arm/build.sh" "$plugin_dir" >/dev/null
 plugin=$plugin_dir/libinsncount.so
 for a in "${arch_list[@]}"; do
   b=$(builddir "$a")
@@ -134,9 +134,9 @@ for a in "${arch_list[@]}"; do
   fi
   [[ -x $b/bin/aerie-capture ]] || die "$b/bin/aerie-capture is not built (run with --build)"
   drv=$plugin_dir/$a/aerie-cost
-  if [[ ! -x $drv || $root/tools/insncount/aerie_cost.cpp -nt $drv || $b/air/track/node/libaerie_track_node.a -nt $drv ]]; then
+  if [[ ! -x $drv || $root/bench/arm/aerie_cost.cpp -nt $drv || $b/air/track/node/libaerie_track_node.a -nt $drv ]]; then
     echo "building $drv" | tee -a "$log"
-    nice -n 10 python3 "$root/tools/insncount/build_driver.py" "$b" "$drv" >>"$log" 2>&1 || die "building the driver failed (see $log)"
+    nice -n 10 python3 "$root/bench/arm/build_driver.py" "$b" "$drv" >>"$log" 2>&1 || die "building the driver failed (see $log)"
   fi
 done
 
@@ -206,5 +206,5 @@ for a in "${arch_list[@]}"; do
   done
 done
 
-python3 "$root/tools/insncount/summarise.py" "$raw" "$out" | tee -a "$log"
+python3 "$root/bench/arm/summarise.py" "$raw" "$out" | tee -a "$log"
 echo "tables: $out/per_frame.tsv, $out/table.md (raw: $raw)"

@@ -13,7 +13,7 @@
  *
  * Options (-plugin ./libinsncount.so,out=FILE): out=FILE appends one line
  * "insns=<total> threads=<vcpus seen>" to FILE (default: QEMU's log, i.e. stderr).
- * Build: tools/insncount/build.sh (scripts/arm-cost.sh calls it).
+ * Build: bench/arm/build.sh (bench/arm/arm-cost.sh calls it).
  */
 #include <stdint.h>
 #include <stdio.h>

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Compiles and links tools/insncount/aerie_cost.cpp against an existing build directory.
+"""Compiles and links bench/arm/aerie_cost.cpp against an existing build directory.
 
 usage: build_driver.py BUILD_DIR OUT_BINARY
 
-The driver is not a CMake target (tools/insncount has no CMakeLists.txt, so no build picks it
+The driver is not a CMake target (bench/arm has no CMakeLists.txt, so no build picks it
 up). Its compile flags are the union of those CMake used for the four nodes' main.cpp
 (compile_commands.json: include directories, definitions, the compiler and its --sysroot),
 and its link line is the four nodes' own link lines put one after the other (`ninja -t
@@ -34,7 +34,7 @@ def main():
     build = os.path.abspath(sys.argv[1])
     out = os.path.abspath(sys.argv[2])
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    src = os.path.join(root, "tools/insncount/aerie_cost.cpp")
+    src = os.path.join(root, "bench/arm/aerie_cost.cpp")
     ccj = os.path.join(build, "compile_commands.json")
     if not os.path.exists(ccj):
         die(f"{ccj} is missing: configure {build} first (cmake --preset ...)")

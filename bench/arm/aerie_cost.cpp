@@ -1,6 +1,6 @@
 // aerie-cost: runs one air-side node's per-frame work in-process, over memq://, on frames read
 // and prepared beforehand, so that an instruction counter around the whole process
-// (tools/insncount, under qemu-user) can be read per frame: scripts/arm-cost.sh runs it with
+// (bench/arm, under qemu-user) can be read per frame: bench/arm/arm-cost.sh runs it with
 // --frames N1 and --frames N2 and the same --prepare, and takes the difference / (N2 - N1).
 // Everything that does not depend on --frames (start-up, loading the libraries, reading and
 // decoding the frames, building the messages) is the same in both runs and cancels.
@@ -12,8 +12,8 @@
 // The node classes are the ones the node binaries run (TrackNode, VoNode, ControlNode), with
 // their defaults (tracker amcmr-ct, VO as aerie-vo with cv::setNumThreads(1), the thesis'
 // initial FLC with one command per pose); the capture node is measured as the aerie-capture
-// binary itself (scripts/arm-cost.sh). Not built by CMake: scripts/arm-cost.sh compiles it
-// against a build directory's libraries (tools/insncount/README.md).
+// binary itself (bench/arm/arm-cost.sh). Not built by CMake: bench/arm/arm-cost.sh compiles it
+// against a build directory's libraries (bench/arm/README.md).
 //
 // Output, one line on stdout: mode, frames processed, output messages, process CPU seconds of
 // the processing loop, and the heap in use (glibc's mallinfo2: allocated bytes of the arenas +
@@ -284,7 +284,7 @@ int run_control(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"aerie-cost: one air-side node's per-frame work in-process (tools/insncount, scripts/arm-cost.sh)"};
+  CLI::App app{"aerie-cost: one air-side node's per-frame work in-process (bench/arm, bench/arm/arm-cost.sh)"};
   app.require_subcommand(1);
   Options o;
   std::string mode;

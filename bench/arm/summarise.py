@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Turns scripts/arm-cost.sh's raw.tsv into per_frame.tsv and table.md.
+"""Turns bench/arm/arm-cost.sh's raw.tsv into per_frame.tsv and table.md.
 
 usage: summarise.py RAW_TSV OUT_DIR
 
