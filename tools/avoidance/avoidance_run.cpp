@@ -91,10 +91,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   link::SplitBus buses(config.split);
   bus::Bus& air = buses.on(link::Side::kAir);
   faults::Injector injector(config.faults, seed);
-  buses.tap([&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
-    injector.observe(side, channel, data, size);
-    if (config.on_message) config.on_message(side, channel, data, size, now_us);
-  });
+  buses.tap(injector.tap(config.on_message));
   sim::FlightSimNodeOptions so;
   so.answer_channels.clear();  // every node below answers on this thread: the buses settled = answered
   sim::FlightSimNode sim_node(air, simulator, so);
@@ -133,12 +130,10 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     nav_node.emplace(nav_bus, [&] { return std::make_unique<nav::NavNode>(nav_bus, config.nav); });
   faults::Respawnable<control::ControlNode> control_node(
       control_bus, [&] { return std::make_unique<control::ControlNode>(control_bus, control_status, config.controller, co, now); });
-  faults::Flight flight;
-  flight.nodes["control"] = [&](bool alive) { alive ? control_node.start() : control_node.kill(); };
-  if (vo_node) flight.nodes["vo"] = [&](bool alive) { alive ? vo_node->start() : vo_node->kill(); };
-  if (nav_node) flight.nodes["nav"] = [&](bool alive) { alive ? nav_node->start() : nav_node->kill(); };
-  flight.stall_cameras = [&](bool stalled) { sim_node.stall_cameras(stalled); };
-  flight.buses = &buses;
+  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }};
+  flight.add("control", control_node);
+  if (vo_node) flight.add("vo", *vo_node);
+  if (nav_node) flight.add("nav", *nav_node);
 
   vo_bus.subscribe<aerie::pose_t>(config.vo.pose, [&](const aerie::pose_t& m, const bus::ReceiveInfo&) {
     ++r.vo_poses;

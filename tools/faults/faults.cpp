@@ -154,6 +154,14 @@ void Injector::observe(link::Side side, const std::string& channel, const uint8_
   last_[{side, channel}].assign(data, data + size);
 }
 
+link::SplitBus::Tap Injector::tap(link::SplitBus::Tap next) {
+  return [this, next = std::move(next)](link::Side side, const std::string& channel, const uint8_t* data, size_t size,
+                                        int64_t now_us) {
+    observe(side, channel, data, size);
+    if (next) next(side, channel, data, size, now_us);
+  };
+}
+
 std::vector<link::LinkDirection*> Injector::directions(Flight& flight) {
   link::SimLink* l = flight.buses->link();
   if (!l) throw std::invalid_argument("link faults need a split deployment (a link between air and ground)");

@@ -4,8 +4,8 @@
 // degrading, a burst of malformed messages on every channel, a NaN pose. A fault starts at
 // a simulation time, so a faulted flight is as reproducible as a clean one.
 //
-// A run (tools/landing) describes its Flight and calls Injector::step once per frame before
-// its buses settle; the injector sees every message through the buses' tap.
+// A run (tools/landing, tools/avoidance) describes its Flight and calls Injector::step once
+// per frame before its buses settle; the injector sees every message through the buses' tap.
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -42,61 +42,6 @@ Fault parse(const std::string& spec);
 std::vector<Fault> parse_list(const std::string& specs);
 std::string to_string(const Fault& fault);  // the spec parse() reads back
 
-// What a flight lets faults act on.
-struct Flight {
-  std::map<std::string, std::function<void(bool alive)>> nodes;  // by name: kill (false), respawn (true)
-  std::function<void(bool stalled)> stall_cameras;
-  link::SplitBus* buses = nullptr;
-};
-
-struct Counters {
-  int64_t kills = 0, respawns = 0;
-  int64_t burst_messages = 0;  // published, every side
-  int64_t nan_messages = 0;
-};
-
-// What a flight saw of its faults (the runs' results, the study's CSV).
-struct Report {
-  Counters counters;
-  std::string applied = "none";    // the faults with their drawn times
-  int64_t stalled_frames = 0;      // frames the cameras published nothing (camera_stall)
-  int64_t command_timeouts = 0;    // the autopilot's offboard-loss holds
-  int64_t malformed = 0;           // messages the buses' decoders refused (the nodes alive at the end)
-};
-
-class Injector {
- public:
-  // Draws the times given as ranges from the seed. Throws std::invalid_argument when faults
-  // overlap in a way that has no meaning (the same node killed twice at once).
-  Injector(std::vector<Fault> faults, uint64_t seed);
-
-  // A SplitBus tap: the channels a burst covers and the newest message of each, per side
-  // (not the injector's own, which are handled in the frame they are published in).
-  void observe(link::Side side, const std::string& channel, const uint8_t* data, size_t size);
-  // Starts and ends what is due at t_s (once per frame, before the buses settle). Throws
-  // std::invalid_argument when a fault names a node the flight does not have, a link fault
-  // has no link, or a NaN pose has no message to copy.
-  void step(double t_s, Flight& flight);
-
-  const Counters& counters() const { return counters_; }
-  // At the end of a flight, with what the simulator counted.
-  Report report(link::SplitBus& buses, int64_t stalled_frames, int64_t command_timeouts) const;
-  const std::vector<Fault>& faults() const { return faults_; }  // with their times drawn
-  std::string applied() const;  // the faults with their times drawn, as specs
-
- private:
-  void burst(link::Side side, int count, bus::Bus& bus);
-  void nan_pose(const std::string& channel, Flight& flight);
-  static std::vector<link::LinkDirection*> directions(Flight& flight);
-
-  std::vector<Fault> faults_;
-  std::vector<int> phase_;  // per fault: 0 pending, 1 active, 2 over
-  std::mt19937_64 rng_;
-  bool publishing_ = false;  // its own messages are on the buses: not observed until the next step
-  std::map<std::pair<link::Side, std::string>, std::vector<uint8_t>> last_;  // newest message per side and channel
-  Counters counters_;
-};
-
 // A node the run can kill — its subscriptions leave the bus with it, messages queued for it
 // are lost — and start again, fresh, as procman respawns a process.
 template <typename Node>
@@ -129,6 +74,69 @@ class Respawnable {
   Make make_;
   std::unique_ptr<Node> node_;
   std::vector<const bus::Subscription*> subs_;
+};
+
+// What a flight lets faults act on.
+struct Flight {
+  link::SplitBus* buses = nullptr;
+  std::function<void(bool stalled)> stall_cameras;
+  std::map<std::string, std::function<void(bool alive)>> nodes;  // by name: kill (false), respawn (true)
+
+  template <typename Node>
+  void add(const std::string& name, Respawnable<Node>& node) {
+    nodes[name] = [&node](bool alive) { alive ? node.start() : node.kill(); };
+  }
+};
+
+
+struct Counters {
+  int64_t kills = 0, respawns = 0;
+  int64_t burst_messages = 0;  // published, every side
+  int64_t nan_messages = 0;
+};
+
+// What a flight saw of its faults (the runs' results, the study's CSV).
+struct Report {
+  Counters counters;
+  std::string applied = "none";    // the faults with their drawn times
+  int64_t stalled_frames = 0;      // frames the cameras published nothing (camera_stall)
+  int64_t command_timeouts = 0;    // the autopilot's offboard-loss holds
+  int64_t malformed = 0;           // messages the buses' decoders refused (the nodes alive at the end)
+};
+
+class Injector {
+ public:
+  // Draws the times given as ranges from the seed. Throws std::invalid_argument when faults
+  // overlap in a way that has no meaning (the same node killed twice at once).
+  Injector(std::vector<Fault> faults, uint64_t seed);
+
+  // A SplitBus tap: the channels a burst covers and the newest message of each, per side
+  // (not the injector's own, which are handled in the frame they are published in).
+  void observe(link::Side side, const std::string& channel, const uint8_t* data, size_t size);
+  // A tap for SplitBus::tap that observes, then hands the message on to `next` (may be empty).
+  link::SplitBus::Tap tap(link::SplitBus::Tap next);
+  // Starts and ends what is due at t_s (once per frame, before the buses settle). Throws
+  // std::invalid_argument when a fault names a node the flight does not have, a link fault
+  // has no link, or a NaN pose has no message to copy.
+  void step(double t_s, Flight& flight);
+
+  const Counters& counters() const { return counters_; }
+  // At the end of a flight, with what the simulator counted.
+  Report report(link::SplitBus& buses, int64_t stalled_frames, int64_t command_timeouts) const;
+  const std::vector<Fault>& faults() const { return faults_; }  // with their times drawn
+  std::string applied() const;  // the faults with their times drawn, as specs
+
+ private:
+  void burst(link::Side side, int count, bus::Bus& bus);
+  void nan_pose(const std::string& channel, Flight& flight);
+  static std::vector<link::LinkDirection*> directions(Flight& flight);
+
+  std::vector<Fault> faults_;
+  std::vector<int> phase_;  // per fault: 0 pending, 1 active, 2 over
+  std::mt19937_64 rng_;
+  bool publishing_ = false;  // its own messages are on the buses: not observed until the next step
+  std::map<std::pair<link::Side, std::string>, std::vector<uint8_t>> last_;  // newest message per side and channel
+  Counters counters_;
 };
 
 }  // namespace aerie::faults

@@ -36,10 +36,7 @@ RunResult fly(const RunConfig& config) {
   link::SplitBus buses(config.split);
   bus::Bus& air = buses.on(link::Side::kAir);
   faults::Injector injector(config.faults, config.sim.seed);
-  buses.tap([&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
-    injector.observe(side, channel, data, size);
-    if (config.on_message) config.on_message(side, channel, data, size, now_us);
-  });
+  buses.tap(injector.tap(config.on_message));
   sim::FlightSimNodeOptions so;
   so.answer_channels.clear();  // a frame is answered when the buses are settled
   sim::FlightSimNode sim_node(air, simulator, so);
@@ -48,11 +45,9 @@ RunResult fly(const RunConfig& config) {
   bus::Bus &track_bus = buses.of("track"), &pilot_bus = buses.of("pilot");
   faults::Respawnable<track::TrackNode> track_node(track_bus, [&] { return std::make_unique<track::TrackNode>(track_bus, to); });
   faults::Respawnable<pilot::PilotNode> pilot_node(pilot_bus, [&] { return std::make_unique<pilot::PilotNode>(pilot_bus, config.pilot); });
-  faults::Flight flight;
-  flight.nodes["track"] = [&](bool alive) { alive ? track_node.start() : track_node.kill(); };
-  flight.nodes["pilot"] = [&](bool alive) { alive ? pilot_node.start() : pilot_node.kill(); };
-  flight.stall_cameras = [&](bool stalled) { sim_node.stall_cameras(stalled); };
-  flight.buses = &buses;
+  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }};
+  flight.add("track", track_node);
+  flight.add("pilot", pilot_node);
   auto wait_tracker = [&] {
     if (track_node.get()) track_node.get()->wait_idle(60000);
   };

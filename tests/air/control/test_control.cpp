@@ -49,6 +49,27 @@ flc::FlcSpec tuned() {
   return s;
 }
 
+// NAV_STATE input, one command per message, the avoidance manoeuvre: 0.4 m/s, turning after 1 m.
+NodeOptions nav_avoidance_options() {
+  NodeOptions opt;
+  opt.input = NodeOptions::Input::kNavState;
+  opt.frame = default_heading_frame(opt.input);
+  opt.rate_hz = 0;
+  opt.control.forward_speed_m_s = 0.4;
+  opt.control.activation_distance_m = 1.0;
+  return opt;
+}
+
+// Level, heading along x, at x metres along it.
+aerie::nav_state_t nav_state(int64_t utime, int8_t status, double x) {
+  aerie::nav_state_t m{};
+  m.utime = utime;
+  m.status = status;
+  m.orientation[0] = 1;
+  m.position[0] = x;
+  return m;
+}
+
 void drain(bus::Bus& bus) {
   while (bus.handle(0) > 0) {
   }
@@ -471,30 +492,17 @@ TEST(HeadingFromPose, NavStateBodyAxisAndConfiguredAxis) {
 TEST(ControlNode, NavStateInputOneCommandPerMessage) {
   // rate_hz 0: every NAV_STATE is answered by one command carrying its utime (lock-step,
   // replay); INITIALISING and LOST states are counted and answered by hover / fallback.
-  NodeOptions opt;
-  opt.input = NodeOptions::Input::kNavState;
-  opt.frame = default_heading_frame(opt.input);
-  opt.rate_hz = 0;
-  opt.control.forward_speed_m_s = 0.4;
-  opt.control.activation_distance_m = 1.0;
+  const NodeOptions opt = nav_avoidance_options();
   bus::Bus bus("memq://");
   bus::StatusReporter status(bus, "control");
   int64_t now = 0;
   ControlNode node(bus, status, tuned(), opt, [&now] { return now; });
   std::vector<aerie::control_cmd_t> cmds;
   bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
-  auto state = [](int64_t utime, int8_t status, double x) {
-    aerie::nav_state_t m{};
-    m.utime = utime;
-    m.status = status;
-    m.orientation[0] = 1;
-    m.position[0] = x;
-    return m;
-  };
-  bus.publish("NAV_STATE", state(0, aerie::nav_state_t::INITIALISING, 0));
+  bus.publish("NAV_STATE", nav_state(0, aerie::nav_state_t::INITIALISING, 0));
   for (int k = 1; k <= 30; ++k) {
     now = k * 5'000;
-    bus.publish("NAV_STATE", state(now, k == 15 ? aerie::nav_state_t::IMU_ONLY : aerie::nav_state_t::OK, 0.04 * k));
+    bus.publish("NAV_STATE", nav_state(now, k == 15 ? aerie::nav_state_t::IMU_ONLY : aerie::nav_state_t::OK, 0.04 * k));
   }
   drain(bus);
   node.tick(10'000'000);  // no timer at rate 0
@@ -517,20 +525,7 @@ TEST(ControlNode, NavStateInputOneCommandPerMessage) {
 TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
   // The fault campaign (docs/faults.md): a respawned aerie-nav starts a new frame, a respawned
   // aerie-control would re-anchor the manoeuvre where the vehicle is; both flew into the wall.
-  NodeOptions opt;
-  opt.input = NodeOptions::Input::kNavState;
-  opt.frame = default_heading_frame(opt.input);
-  opt.rate_hz = 0;
-  opt.control.forward_speed_m_s = 0.4;
-  opt.control.activation_distance_m = 1.0;
-  auto state = [](int64_t utime, int8_t status, double x) {
-    aerie::nav_state_t m{};
-    m.utime = utime;
-    m.status = status;
-    m.orientation[0] = 1;
-    m.position[0] = x;
-    return m;
-  };
+  const NodeOptions opt = nav_avoidance_options();
   for (const bool restarted_nav : {true, false}) {
     bus::Bus bus("memq://");
     bus::StatusReporter status(bus, "control");
@@ -541,13 +536,13 @@ TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
     // Nav restarted (OK, then INITIALISING, then OK in its new frame); or a control started
     // in flight, its first pose 2 m from the frame's origin.
     const double x0 = restarted_nav ? 0.0 : 2.0;
-    for (int k = 1; k <= 10; ++k) bus.publish("NAV_STATE", state(now = k * 5'000, aerie::nav_state_t::OK, x0 + 0.04 * k));
+    for (int k = 1; k <= 10; ++k) bus.publish("NAV_STATE", nav_state(now = k * 5'000, aerie::nav_state_t::OK, x0 + 0.04 * k));
     if (restarted_nav) {
-      bus.publish("NAV_STATE", state(now = 50'500, aerie::nav_state_t::INITIALISING, 0));  // one alone: corrupt
-      bus.publish("NAV_STATE", state(now = 51'000, aerie::nav_state_t::OK, 0.41));
-      for (int k = 0; k < 3; ++k) bus.publish("NAV_STATE", state(now = 52'000 + 1'000 * k, aerie::nav_state_t::INITIALISING, 0));
+      bus.publish("NAV_STATE", nav_state(now = 50'500, aerie::nav_state_t::INITIALISING, 0));  // one alone: corrupt
+      bus.publish("NAV_STATE", nav_state(now = 51'000, aerie::nav_state_t::OK, 0.41));
+      for (int k = 0; k < 3; ++k) bus.publish("NAV_STATE", nav_state(now = 52'000 + 1'000 * k, aerie::nav_state_t::INITIALISING, 0));
     }
-    for (int k = 12; k <= 20; ++k) bus.publish("NAV_STATE", state(now = k * 5'000, aerie::nav_state_t::OK, 0.04 * k));
+    for (int k = 12; k <= 20; ++k) bus.publish("NAV_STATE", nav_state(now = k * 5'000, aerie::nav_state_t::OK, 0.04 * k));
     drain(bus);
     ASSERT_EQ(cmds.size(), restarted_nav ? 24u : 19u) << restarted_nav;
     EXPECT_EQ(cmds.front().mode, restarted_nav ? aerie::control_cmd_t::ACTIVE : aerie::control_cmd_t::FALLBACK_HOVER);

@@ -15,15 +15,30 @@
 
 using namespace aerie;
 
-TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
-  bus::Bus bus("memq://");
-  pilot::PilotNode node(bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml")));
+namespace {
+
+// aerie-pilot with the shipped config on memq://, and the commands it publishes.
+struct PilotOnBus {
+  bus::Bus bus{"memq://"};
+  pilot::PilotNode node{bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"))};
   std::vector<aerie::control_cmd_t> cmds;
-  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
-  auto drain = [&] {
+  PilotOnBus() {
+    bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [this](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) {
+      cmds.push_back(m);
+    });
+  }
+  void drain() {
     while (bus.handle(0) > 0) {
     }
-  };
+  }
+};
+
+}  // namespace
+
+TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
+  PilotOnBus p;
+  auto& [bus, node, cmds] = p;
+  auto drain = [&] { p.drain(); };
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
   for (int k = 1; k <= 3; ++k) {
@@ -64,14 +79,9 @@ TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
 TEST(PilotNode, OneBogusStampIsHeldAndNeverMovesItsClock) {
   // A corrupt or hostile message stamped far from its source's time (fault campaign: a
   // bit-flipped IMU stamp made the pilot see its tracker silent for 1.4e8 s and abort).
-  bus::Bus bus("memq://");
-  pilot::PilotNode node(bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml")));
-  std::vector<aerie::control_cmd_t> cmds;
-  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
-  auto drain = [&] {
-    while (bus.handle(0) > 0) {
-    }
-  };
+  PilotOnBus p;
+  auto& [bus, node, cmds] = p;
+  auto drain = [&] { p.drain(); };
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
   aerie::imu_t imu{};
