@@ -101,7 +101,7 @@ struct Report {
   std::string applied = "none";    // the faults with their drawn times
   int64_t stalled_frames = 0;      // frames the cameras published nothing (camera_stall)
   int64_t command_timeouts = 0;    // the autopilot's offboard-loss holds
-  int64_t malformed = 0;           // messages the buses' decoders refused (the nodes alive at the end)
+  int64_t malformed = 0;           // refusals by the decoders, per subscription (of the nodes alive at the end)
 };
 
 class Injector {

@@ -181,8 +181,8 @@ void write_report(const StudyConfig& study, const std::vector<RunSpec>& specs,
     md << "\n## Faults in flight (" << workload_name(w) << ")\n\nSafe: no collision. Completed: "
        << (land ? "landed on the pad (the landing's success)" : "turned along the wall without entering the danger zone")
        << ". Fallback: runs in which " << (land ? "the pilot held on stale inputs" : "aerie-control hovered on stale inputs")
-       << "; offboard hold: runs in which the autopilot held because commands stopped (1 s). Malformed: messages the "
-          "decoders of the nodes alive at the end refused, per run.\n";
+       << "; offboard hold: runs in which the autopilot held because commands stopped (1 s). Malformed: decoder "
+          "refusals (per subscription) of the nodes alive at the end, per run.\n";
     const std::vector<std::string> trackers = land ? study.trackers : std::vector<std::string>{"-"};
     for (const auto& t : trackers)
       for (const auto& p : study.placements)
