@@ -80,7 +80,7 @@ void append_record(std::vector<uint8_t>& out, uint8_t channel, std::span<const u
 void publish_records(bus::Bus& bus, const std::vector<std::string>& channels, const uint8_t* data, size_t size,
                      const std::function<void()>& after_each) {
   for (const Record& r : split_records(data, size, channels.size())) {
-    bus.raw().publish(channels[r.channel], r.payload.data(), static_cast<unsigned>(r.payload.size()));
+    bus.publish_raw(channels[r.channel], r.payload.data(), static_cast<unsigned>(r.payload.size()));
     while (bus.handle(0) > 0) {
     }
     if (after_each) after_each();

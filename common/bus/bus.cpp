@@ -5,11 +5,15 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <limits>
 #include <sys/select.h>
 
 namespace aerie::bus {
 
 void Subscription::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+#if AERIE_TSAN
+  { std::lock_guard<std::mutex> hand_off(bus_->hand_off_); }  // after the publish that queued rbuf (bus.hpp)
+#endif
   ++counters_.received;
   try {
     dispatch(rbuf, channel);
@@ -58,6 +62,7 @@ Bus::~Bus() {
 
 Subscription& Bus::attach(std::unique_ptr<Subscription> sub, const std::string& channel, int queue_capacity) {
   sub->channel_ = channel;
+  sub->bus_ = this;
   // LCM matches "^" + regex + "$": grouped, alternatives ("A|B") match whole names only.
   sub->handle_ = lcm_.subscribe("(" + channel + ")", &Subscription::on_raw, sub.get());
   if (!sub->handle_) throw std::runtime_error("cannot subscribe to " + channel);
@@ -71,6 +76,12 @@ void Bus::unsubscribe(const Subscription& sub) {
   if (it == subs_.end()) throw std::invalid_argument("unsubscribe: " + sub.channel() + " is not a subscription of this bus");
   if ((*it)->handle_) lcm_.unsubscribe((*it)->handle_);
   subs_.erase(it);
+}
+
+void Bus::publish_raw(const std::string& channel, const void* data, size_t size) {
+  HandOff hand_off(*this);
+  if (size > std::numeric_limits<unsigned>::max() || lcm_.publish(channel, data, static_cast<unsigned>(size)) != 0)
+    ++publish_errors_;
 }
 
 int Bus::handle(int timeout_ms) {

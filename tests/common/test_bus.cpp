@@ -32,7 +32,7 @@ TEST(Bus, CorruptPayloadIsCountedNotDelivered) {
   int delivered = 0;
   auto& sub = bus.subscribe<aerie::image_t>("CAM_LEFT", [&](const aerie::image_t&, const ReceiveInfo&) { ++delivered; });
   const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
-  bus.raw().publish("CAM_LEFT", junk, sizeof(junk));
+  bus.publish_raw("CAM_LEFT", junk, sizeof(junk));
   aerie::pose_t wrong_type{};
   bus.publish("CAM_LEFT", wrong_type);  // fingerprint mismatch
   while (bus.handle(0) > 0) {
@@ -88,7 +88,7 @@ TEST(Bus, RawSubscriptionSeesAnyTypeAndPeeksUtime) {
   bus.publish("VO_POSE", p);
   bus.publish("OTHER", p);
   const uint8_t tiny[3] = {1, 2, 3};
-  bus.raw().publish("VO_X", tiny, 3);
+  bus.publish_raw("VO_X", tiny, 3);
   while (bus.handle(0) > 0) {
   }
   ASSERT_EQ(got.size(), 2u);
@@ -103,7 +103,7 @@ TEST(Bus, ChannelRegexWithAlternativesMatchesWholeNamesOnly) {
   std::vector<std::string> got;
   bus.subscribe_raw("TRACK|CAM_DOWN", [&](const uint8_t*, size_t, const ReceiveInfo& info) { got.push_back(info.channel); });
   const uint8_t b[16] = {};
-  for (const char* ch : {"TRACK", "GT_TRACK", "TRACK_CMD", "CAM_DOWN", "CAM_DOWN2", "XCAM_DOWN"}) bus.raw().publish(ch, b, sizeof b);
+  for (const char* ch : {"TRACK", "GT_TRACK", "TRACK_CMD", "CAM_DOWN", "CAM_DOWN2", "XCAM_DOWN"}) bus.publish_raw(ch, b, sizeof b);
   while (bus.handle(0) > 0) {
   }
   EXPECT_EQ(got, (std::vector<std::string>{"TRACK", "CAM_DOWN"}));

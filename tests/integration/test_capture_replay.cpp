@@ -199,7 +199,7 @@ TEST(CaptureReplay, MemqRecordAndReplayInProcess) {
   logio::Reader reader((dir / "memq.lcm").string());
   logio::Event ev;
   while (reader.next(ev)) {
-    replay_bus.raw().publish(ev.channel, ev.data.data(), static_cast<unsigned>(ev.data.size()));
+    replay_bus.publish_raw(ev.channel, ev.data.data(), static_cast<unsigned>(ev.data.size()));
     replay_bus.handle(0);
   }
   while (replay_bus.handle(0) > 0) {
@@ -224,7 +224,7 @@ TEST(CaptureReplay, CorruptCameraPayloadsDoNotCrashAConsumer) {
   const cv::Mat img(12, 16, CV_8UC1, cv::Scalar(3));
   const auto good = image::to_message(img, 1, 0);
   auto publish_bytes = [&](const std::string& ch, std::vector<uint8_t> b) {
-    bus.raw().publish(ch, b.data(), static_cast<unsigned>(b.size()));
+    bus.publish_raw(ch, b.data(), static_cast<unsigned>(b.size()));
     bus.handle(0);
   };
   // 1. random bytes, 2. a good image cut short, 3. another type on the channel,

@@ -253,7 +253,7 @@ void Injector::burst(link::Side side, int count, bus::Bus& bus) {
         }
         break;
     }
-    bus.raw().publish(key.second, m.data(), static_cast<unsigned>(m.size()));
+    bus.publish_raw(key.second, m.data(), static_cast<unsigned>(m.size()));
     ++counters_.burst_messages;
   }
 }
@@ -278,7 +278,7 @@ void Injector::nan_pose(const std::string& channel, Flight& flight) {
     else
       throw std::invalid_argument("nan_pose: channel " + channel + " is not TARGET_POSE or VO_POSE");
     publishing_ = true;
-    flight.buses->on(side).raw().publish(channel, out.data(), static_cast<unsigned>(out.size()));
+    flight.buses->on(side).publish_raw(channel, out.data(), static_cast<unsigned>(out.size()));
     ++counters_.nan_messages;
     return;
   }

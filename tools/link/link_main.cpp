@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
         for (auto& p : r.relay.due(now)) {
           const uint64_t k = EchoFilter::key(p.channel, p.data.data(), p.data.size());
           if (r.reverse(p.channel)) r.to->echo.sent(k, now);
-          r.to->bus->raw().publish(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
+          r.to->bus->publish_raw(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
           r.delays_ms.push_back(static_cast<double>(util::wall_utime() - p.recv_wall_utime) / 1000.0);
         }
       }

@@ -45,7 +45,7 @@ int SimLink::deliver() {
     const Side to = r == &down_ ? Side::kGround : Side::kAir;
     bus::Bus& b = to == Side::kGround ? ground_ : air_;
     for (const Packet& p : r->due(now_us_)) {
-      b.raw().publish(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
+      b.publish_raw(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
       ++n;
     }
   }

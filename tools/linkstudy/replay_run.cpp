@@ -63,7 +63,7 @@ ReplayResult replay(const ReplayConfig& config) {
     now = events[i].utime;
     for (; i < events.size() && events[i].utime == now; ++i)
       if (events[i].channel != to.track_channel && events[i].channel != to.pose_channel)
-        buses.on(link::Side::kAir).raw().publish(events[i].channel, events[i].data.data(),
+        buses.on(link::Side::kAir).publish_raw(events[i].channel, events[i].data.data(),
                                                  static_cast<unsigned>(events[i].data.size()));
     buses.settle(now, [&] { track_node.wait_idle(60000); });
   }

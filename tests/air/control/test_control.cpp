@@ -228,7 +228,7 @@ TEST(ControlNode, RefusesMalformedParametersAndTimesOutToHover) {
   bad3.values = {1.0};
   bus.publish("FLC_PARAMS", bad3);
   const uint8_t junk[5] = {1, 2, 3, 4, 5};
-  bus.raw().publish("FLC_PARAMS", junk, sizeof(junk));  // not even a flc_params_t
+  bus.publish_raw("FLC_PARAMS", junk, sizeof(junk));  // not even a flc_params_t
   drain(bus);
   status.publish_now();
   drain(bus);
@@ -298,7 +298,7 @@ TEST(ControlNode, OversizedControllersAreRefusedBeforeAllocationAndCommandsGoOn)
   drain(bus);
   for (const char* file : {"flc_params_fll_1000cubed_12GB_alloc.bin", "flc_params_fll_2048x2048x1024_overflow.bin"}) {
     const auto payload = test::read_bytes(test::reliability_data_dir() / file);
-    bus.raw().publish("FLC_PARAMS", payload.data(), static_cast<unsigned>(payload.size()));
+    bus.publish_raw("FLC_PARAMS", payload.data(), static_cast<unsigned>(payload.size()));
     drain(bus);
     // Refused by the parser at the 65th set, before any table is sized.
     EXPECT_NE(status.message().find("more than 64 terms"), std::string::npos) << file << ": " << status.message();
@@ -369,7 +369,7 @@ TEST(ControlNode, AFutureStampedPoseIsHeldAndControlKeepsFlying) {
   int64_t t = 5'000'000;
   for (int k = 0; k < 5; ++k, t += 33'333) EXPECT_EQ(s.step(t).mode, aerie::control_cmd_t::ACTIVE);
   const auto payload = test::read_bytes(test::reliability_data_dir() / "vo_pose_utime_INT64_MAX.bin");
-  s.bus.raw().publish("VO_POSE", payload.data(), static_cast<unsigned>(payload.size()));
+  s.bus.publish_raw("VO_POSE", payload.data(), static_cast<unsigned>(payload.size()));
   EXPECT_EQ(s.step(std::nullopt).mode, aerie::control_cmd_t::ACTIVE);
   EXPECT_EQ(s.status.counter("VO_POSE.time_jumps"), 1);
   EXPECT_NE(s.status.message().find("VO_POSE utime 9223372036854775807 jumps forwards"), std::string::npos)

@@ -88,7 +88,7 @@ TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
   EXPECT_EQ(node.processed(), 6);
   // A garbage message on the channel is counted by the bus and dropped.
   const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
-  bus.raw().publish("CAM_STEREO", junk, sizeof junk);
+  bus.publish_raw("CAM_STEREO", junk, sizeof junk);
   while (bus.handle(0) > 0) {
   }
   // And the node goes on with good pairs.

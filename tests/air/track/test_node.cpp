@@ -185,7 +185,7 @@ TEST_F(NodeTest, BadMessagesAndCommandsAreCountedNotFatal) {
   TrackNode node(bus_, NodeOptions{});
   aerie::bus::StatusReporter status(bus_, "track");
   const uint8_t junk[5] = {1, 2, 3, 4, 5};
-  bus_.raw().publish("CAM_LEFT", junk, sizeof(junk));  // not an image_t
+  bus_.publish_raw("CAM_LEFT", junk, sizeof(junk));  // not an image_t
   aerie::image_t bad = frame(0);
   bad.size = 10;
   bad.data.resize(10);  // inconsistent payload: decodes as an error
@@ -367,7 +367,7 @@ TEST_F(NodeTest, APngBombIsRefusedBeforeDecoding) {
   TrackNode node(bus_, NodeOptions{});
   aerie::bus::StatusReporter status(bus_, "track");
   const auto payload = aerie::test::read_bytes(aerie::test::reliability_data_dir() / "cam_left_png_bomb_16000x16000.bin");
-  bus_.raw().publish("CAM_LEFT", payload.data(), static_cast<unsigned>(payload.size()));
+  bus_.publish_raw("CAM_LEFT", payload.data(), static_cast<unsigned>(payload.size()));
   settle(node);
   EXPECT_EQ(node.counter("decode_errors"), 1);
   node.report(status);

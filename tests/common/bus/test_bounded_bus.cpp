@@ -28,7 +28,7 @@ void expect_survives(const std::string& channel, const std::string& file) {
   aerie::bus::Bus bus("memq://");
   int delivered = 0;
   auto& sub = bus.subscribe<Msg>(channel, [&](const Msg&, const aerie::bus::ReceiveInfo&) { ++delivered; });
-  bus.raw().publish(channel, crafted.data(), static_cast<unsigned>(crafted.size()));
+  bus.publish_raw(channel, crafted.data(), static_cast<unsigned>(crafted.size()));
   bus.publish(channel, Msg{});
   while (bus.handle(0) > 0) {
   }

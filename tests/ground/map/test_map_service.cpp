@@ -475,7 +475,7 @@ TEST(MapService, LoadChecksTheFileAndKeepsTheOldMap) {
   // its reply channel FZ_RESPONSE is not a map reply channel, so it is refused; the same query
   // on MAP_RESPONSE_TEST is answered from the old map.
   const auto payload = aerie::test::read_bytes(aerie::test::reliability_data_dir() / "map_query_nearest_obstacle_origin.bin");
-  h.bus.raw().publish("MAP_QUERY", payload.data(), static_cast<unsigned>(payload.size()));
+  h.bus.publish_raw("MAP_QUERY", payload.data(), static_cast<unsigned>(payload.size()));
   h.spin();
   EXPECT_EQ(h.counter("query_reply_refused"), 1);
   const auto origin = h.query(aerie::map_query_t::NEAREST_OBSTACLE, Eigen::Vector3d::Zero());

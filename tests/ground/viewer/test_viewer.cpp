@@ -317,7 +317,7 @@ TEST_F(Fixture, SurvivesMalformedMessagesAndChannelsThatStopAndRestart) {
   make();
   const uint8_t junk[5] = {9, 9, 9, 9, 9};
   for (const char* ch : {"CAM_LEFT", "TRACK", "MAP_OCTOMAP", "VO_DEPTH", "CTRL_CMD", "STATUS_X"})
-    bus.raw().publish(ch, junk, sizeof(junk));
+    bus.publish_raw(ch, junk, sizeof(junk));
   aerie::octomap_t bad{};
   bad.resolution = 0.1;
   bad.binary = true;

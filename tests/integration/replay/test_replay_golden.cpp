@@ -93,7 +93,7 @@ std::map<std::string, std::vector<Message>> replay(const std::vector<Message>& l
     }
   };
   for (const auto& m : log) {
-    bus.raw().publish(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
+    bus.publish_raw(m.channel, m.bytes.data(), static_cast<unsigned>(m.bytes.size()));
     if (!burst) drain();
   }
   drain();
