@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
@@ -43,6 +44,7 @@ void PilotConfig::validate() const {
        "tolerances, descent.gate_m and descent.handover_tolerance_m must be > 0");
   need(settle_frames >= 1 && loss_frames >= 1 && handover_frames >= 1,
        "settle_frames, loss_frames and descent.handover_frames must be >= 1");
+  need(max_input_age_s >= 0 && max_input_age_s <= 60, "max_input_age_s must be in [0, 60] s (0 = off)");
   need(stale_timeout_s > 0 && control_period_s > 0 && abort_climb_s >= 0 && hold_climb_max_s >= 0,
        "stale_timeout_s and control_period_s must be > 0");
   for (const auto& leg : survey_legs) need(leg.allFinite(), "survey legs must be finite");
@@ -104,8 +106,19 @@ Command Pilot::steer(int64_t utime, double t, const Eigen::Vector3d& target, dou
   return c;
 }
 
-Command Pilot::on_track(int64_t utime, TrackStatus status) {
+Command Pilot::on_track(int64_t utime, TrackStatus status, std::optional<double> age_s) {
   last_track_ = utime;
+  if (cfg_.max_input_age_s > 0 && age_s && *age_s > cfg_.max_input_age_s) {
+    ++status_.aged_results;
+    if (status_.state == State::Approach || status_.state == State::Descend) {
+      resume_state_ = status_.state;
+      ++status_.age_holds;
+      char why[96];
+      std::snprintf(why, sizeof why, "tracker result %.2f s old (limit %.2f s)", *age_s, cfg_.max_input_age_s);
+      enter(State::Hold, utime, why);
+    }
+    return tick(utime, false, TrackStatus::Idle);  // no target from it: HOLD cannot re-acquire on it
+  }
   return tick(utime, true, status);
 }
 

@@ -55,6 +55,11 @@ struct PilotConfig {
   int handover_frames = 3;             // ... for this many frames in a row (the LAND below is blind)
   double touchdown_time_s = 3.0;     // TOUCHDOWN -> LANDED after this long
   double stale_timeout_s = 0.5;      // no tracker result for this long -> HOLD
+  // A tracker result whose frame is older than this on the pilot's clock (the link's delay
+  // from the camera to the pilot) is not flown on: APPROACH/DESCEND -> HOLD. The pilot sees
+  // one way of the round trip; 0.4 s each way is where the landing's error passed 10 cm
+  // (docs/results/linkstudy.md, the delay edge). 0 = off.
+  double max_input_age_s = 0.4;
   int loss_frames = 3;               // tracker lost this many frames in a row -> HOLD
   double hold_timeout_s = 8.0;       // HOLD for this long -> ABORT
   double hold_climb_m_s = 0.15;      // HOLD climbs slowly (a wider view helps re-acquisition) ...
@@ -97,6 +102,8 @@ struct PilotStatus {
   double height_m = std::nan("");
   int losses = 0, reacquisitions = 0;
   int stale_holds = 0;  // HOLDs entered because the tracker fell silent (inputs stale)
+  int age_holds = 0;    // HOLDs entered because its results were older than max_input_age_s
+  int aged_results = 0; // tracker results not flown on because of their age
 };
 
 class Pilot {
@@ -108,8 +115,10 @@ class Pilot {
   // A target pose; used by the tick of the frame with the same utime. Throws
   // std::invalid_argument for non-finite values (the node counts and drops them).
   void on_target(const TargetObservation& target);
-  // The tick of a processed frame: the tracker's status on it.
-  Command on_track(int64_t utime, TrackStatus status);
+  // The tick of a processed frame: the tracker's status on it, and the age of the frame on
+  // the pilot's clock (the node's clock minus the frame's capture time; nullopt when the two
+  // clocks are not comparable). A result older than max_input_age_s ticks without a target.
+  Command on_track(int64_t utime, TrackStatus status, std::optional<double> age_s = std::nullopt);
   // The IMU clock: a tick (hover in HOLD, or the state's command) when the tracker has
   // been silent for stale_timeout_s; nullopt while it is not.
   std::optional<Command> on_clock(int64_t utime);

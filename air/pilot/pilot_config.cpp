@@ -58,8 +58,8 @@ PilotConfig load_pilot_config(const util::Config& cfg) {
       "handover_frames", &P::handover_frames)("touchdown_time_s", &P::touchdown_time_s)
       .finish();
   util::SectionReader<P>(cfg.section("hold"), p)("stale_timeout_s", &P::stale_timeout_s)(
-      "loss_frames", &P::loss_frames)("timeout_s", &P::hold_timeout_s)("climb_m_s", &P::hold_climb_m_s)(
-      "climb_max_s", &P::hold_climb_max_s)
+      "max_input_age_s", &P::max_input_age_s)("loss_frames", &P::loss_frames)("timeout_s", &P::hold_timeout_s)(
+      "climb_m_s", &P::hold_climb_m_s)("climb_max_s", &P::hold_climb_max_s)
       .finish();
   util::SectionReader<P>(cfg.section("abort"), p)("climb_m_s", &P::abort_climb_m_s)("climb_s", &P::abort_climb_s)
       .finish();

@@ -44,7 +44,10 @@ RunResult fly(const RunConfig& config) {
   to.every_frame = true;  // lock-step: every frame delivered is tracked
   bus::Bus &track_bus = buses.of("track"), &pilot_bus = buses.of("pilot");
   faults::Respawnable<track::TrackNode> track_node(track_bus, [&] { return std::make_unique<track::TrackNode>(track_bus, to); });
-  faults::Respawnable<pilot::PilotNode> pilot_node(pilot_bus, [&] { return std::make_unique<pilot::PilotNode>(pilot_bus, config.pilot); });
+  // The pilot's clock is the simulation's: its input-age rule sees the link's delay, not the machine's speed.
+  const util::NodeClock now = [&simulator] { return simulator.utime_of(simulator.time()); };
+  faults::Respawnable<pilot::PilotNode> pilot_node(
+      pilot_bus, [&] { return std::make_unique<pilot::PilotNode>(pilot_bus, config.pilot, pilot::PilotNodeOptions{}, now); });
   faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }};
   flight.add("track", track_node);
   flight.add("pilot", pilot_node);
@@ -90,7 +93,7 @@ RunResult fly(const RunConfig& config) {
   if (const pilot::PilotNode* p = pilot_node.get()) {
     r.losses = p->pilot().status().losses;
     r.reacquisitions = p->pilot().status().reacquisitions;
-    r.pilot_stale_holds = p->pilot().status().stale_holds;
+    r.pilot_stale_holds = p->pilot().status().stale_holds + p->pilot().status().age_holds;
     for (const char* ch : {"TARGET_POSE", "TRACK", "IMU"})
       r.pilot_refused += p->counter(std::string(ch) + "_refused") + p->counter(std::string(ch) + "_time_held");
   }

@@ -49,7 +49,7 @@ struct RunResult {
   sim::FlightOutcome outcome;
   std::string final_state;         // the pilot's (of its last incarnation)
   int losses = 0, reacquisitions = 0;
-  int64_t pilot_stale_holds = 0;   // the pilot's HOLDs on stale inputs
+  int64_t pilot_stale_holds = 0;   // the pilot's HOLDs on stale inputs: a silent tracker, or results older than its age limit
   int64_t lockstep_timeouts = 0, target_poses = 0, commands_refused = 0;
   int64_t pad_refined = 0, pad_not_found = 0, tracker_reseeded = 0;  // aerie-track's counters (last incarnation)
   std::string pad_misses;          // "reason:count ..." of the frames the pad was not found

@@ -44,7 +44,7 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
         throw std::invalid_argument("unknown track status " + std::to_string(m.status));
       if (!on_time(track_time_, opt_.track_channel, m.utime)) return;
       count("tracks");
-      publish(pilot_.on_track(m.utime, static_cast<TrackStatus>(m.status)));
+      publish(pilot_.on_track(m.utime, static_cast<TrackStatus>(m.status), input_age(m.utime)));
     });
   });
   bus_.subscribe<aerie::imu_t>(opt_.imu_channel, [this, guarded](const aerie::imu_t& m, const bus::ReceiveInfo&) {
@@ -85,6 +85,17 @@ bool PilotNode::on_time(util::MessageClock& clock, const std::string& channel, i
   last_error_ = channel + ": " + r.reason;
   spdlog::warn("{}", last_error_);
   return false;
+}
+
+std::optional<double> PilotNode::input_age(int64_t utime) {
+  const double age_s = (static_cast<double>(now_()) - static_cast<double>(utime)) * 1e-6;
+  // A minute apart, the frame was not stamped on this clock: a lock-step simulation starts
+  // at 0, a replayed log at its recording. No link delays a frame that long.
+  if (std::abs(age_s) > kComparableClockS) {
+    last_age_s_.reset();
+    return std::nullopt;
+  }
+  return last_age_s_ = age_s;
 }
 
 void PilotNode::publish(const Command& c) {
@@ -144,6 +155,10 @@ void PilotNode::report(bus::StatusReporter& status) const {
   const PilotStatus& s = pilot_.status();
   status.set("losses", s.losses);
   status.set("stale_holds", s.stale_holds);
+  status.set("age_holds", s.age_holds);
+  status.set("aged_results", s.aged_results);
+  // The newest TRACK's age on this node's clock; -1 when the clocks are not comparable.
+  status.set("input_age_ms", last_age_s_ ? std::llround(*last_age_s_ * 1e3) : -1);
   status.set("reacquisitions", s.reacquisitions);
   const std::string msg = std::string(state_name(s.state)) + ": " + s.reason;
   if (s.state == State::Hold || s.state == State::Abort || s.state == State::Aborted)

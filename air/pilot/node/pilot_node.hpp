@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "air/pilot/pilot.hpp"
@@ -41,6 +42,10 @@ class PilotNode {
   void count(const std::string& name) { ++counters_[name]; }
   // The message-time policy: false (counted "<channel>_time_held", logged) for a held stamp.
   bool on_time(util::MessageClock& clock, const std::string& channel, int64_t utime);
+  // A frame's age on the node's clock (PilotConfig::max_input_age_s), or nullopt when its
+  // stamp is more than kComparableClockS from that clock (not the same time base).
+  std::optional<double> input_age(int64_t utime);
+  static constexpr double kComparableClockS = 60;
 
   bus::Bus& bus_;
   Pilot pilot_;
@@ -50,6 +55,7 @@ class PilotNode {
   std::map<std::string, int64_t> counters_;
   std::string last_error_;
   State last_state_ = State::Idle;
+  std::optional<double> last_age_s_;
   int64_t cmd_seq_ = 0, state_seq_ = 0;
 };
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "air/pilot/pilot.hpp"
 #include "air/pilot/pilot_config.hpp"
@@ -30,12 +31,13 @@ struct Flight {
   Pilot pilot;
   int64_t utime = 0;
   explicit Flight(PilotConfig c) : pilot(std::move(c)) {}
+  std::optional<double> age_s;  // of every frame on the pilot's clock (nullopt: not comparable)
   Command frame(TrackStatus status = TrackStatus::Idle, double height = 0, Eigen::Vector2d offset = {0, 0},
                 double yaw_error_deg = 0, bool fitted = true) {
     utime += kFrame;
     if (status == TrackStatus::Tracking || status == TrackStatus::Redetected)
       pilot.on_target({utime, {offset.x(), offset.y(), height}, (yaw_error_deg - 90) * kDeg, fitted});
-    return pilot.on_track(utime, status);
+    return pilot.on_track(utime, status, age_s);
   }
   // Frames until the state changes (at most n); returns the frames flown.
   int until_change(int n, TrackStatus status = TrackStatus::Idle, double height = 0) {
@@ -180,6 +182,63 @@ TEST(Pilot, ASilentTrackerIsStaleAndHoldsThenTheHoldTimesOutIntoAnAbort) {
   EXPECT_GT(climb->velocity.z(), 0.0);
   while (f.pilot.state() == State::Abort) f.pilot.on_clock(t += kFrame);
   EXPECT_EQ(f.pilot.state(), State::Aborted);
+}
+
+TEST(Pilot, ResultsOlderThanTheAgeLimitHoldAndOnlyFreshOnesResume) {
+  // Behind a steady link delay the tracker is never silent, its results are only old: the
+  // gap rule above cannot see it (docs/results/linkstudy.md section 4).
+  Flight f(config());
+  const double limit = f.pilot.config().max_input_age_s;
+  ASSERT_GT(limit, 0.0);
+  f.frame();
+  f.until_change(1000);
+  f.frame(TrackStatus::Tracking, 2.0);
+  while (f.pilot.state() != State::Descend) f.frame(TrackStatus::Tracking, 2.0);
+  f.age_s = limit - 0.01;  // within the limit: flown on
+  f.frame(TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(f.pilot.state(), State::Descend);
+  f.age_s = limit + 0.1;
+  const Command hold = f.frame(TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(f.pilot.state(), State::Hold);
+  EXPECT_EQ(hold.velocity.head<2>().norm(), 0.0);
+  EXPECT_NE(f.pilot.status().reason.find("s old (limit"), std::string::npos) << f.pilot.status().reason;
+  EXPECT_EQ(f.pilot.status().age_holds, 1);
+  EXPECT_EQ(f.pilot.status().losses, 0);  // not a loss: the target is tracked, too late
+  for (int i = 0; i < 5; ++i) f.frame(TrackStatus::Tracking, 1.9);  // old results never re-acquire
+  EXPECT_EQ(f.pilot.state(), State::Hold);
+  EXPECT_EQ(f.pilot.status().aged_results, 6);
+  f.age_s.reset();  // clocks not comparable: no age rule
+  f.frame(TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(f.pilot.state(), State::Descend);
+  EXPECT_EQ(f.pilot.status().reacquisitions, 1);
+  // A link that stays slow: HOLD, then the hold times out into an abort.
+  f.age_s = limit + 0.1;
+  const int frames = f.until_change(1000, TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(frames, 1);
+  EXPECT_EQ(f.pilot.state(), State::Hold);
+  const int held = f.until_change(10000, TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(f.pilot.state(), State::Abort);
+  EXPECT_NEAR(held * 0.05, f.pilot.config().hold_timeout_s, 0.051);
+  EXPECT_EQ(f.pilot.status().age_holds, 2);
+}
+
+TEST(Pilot, AnAgeLimitOfZeroIsOffAndANegativeOneIsRefused) {
+  PilotConfig c = config();
+  c.max_input_age_s = 0;
+  Flight f(c);
+  f.age_s = 30.0;
+  f.frame();
+  f.until_change(1000);
+  f.frame(TrackStatus::Tracking, 2.0);
+  EXPECT_EQ(f.pilot.state(), State::Approach);
+  EXPECT_EQ(f.pilot.status().aged_results, 0);
+  c.max_input_age_s = -0.1;
+  try {
+    Pilot p(c);
+    FAIL() << "a negative age limit was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_input_age_s"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Pilot, NoTargetAfterTheSurveyAbortsAfterTheAcquireTimeout) {

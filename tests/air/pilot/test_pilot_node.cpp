@@ -20,7 +20,9 @@ namespace {
 // aerie-pilot with the shipped config on memq://, and the commands it publishes.
 struct PilotOnBus {
   bus::Bus bus{"memq://"};
-  pilot::PilotNode node{bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"))};
+  int64_t now_us = 0;  // the node's clock
+  pilot::PilotNode node{bus, pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml")), {},
+                        [this] { return now_us; }};
   std::vector<aerie::control_cmd_t> cmds;
   PilotOnBus() {
     bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [this](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) {
@@ -37,7 +39,9 @@ struct PilotOnBus {
 
 TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
   PilotOnBus p;
-  auto& [bus, node, cmds] = p;
+  auto& bus = p.bus;
+  auto& node = p.node;
+  auto& cmds = p.cmds;
   auto drain = [&] { p.drain(); };
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
@@ -80,7 +84,9 @@ TEST(PilotNode, OneBogusStampIsHeldAndNeverMovesItsClock) {
   // A corrupt or hostile message stamped far from its source's time (fault campaign: a
   // bit-flipped IMU stamp made the pilot see its tracker silent for 1.4e8 s and abort).
   PilotOnBus p;
-  auto& [bus, node, cmds] = p;
+  auto& bus = p.bus;
+  auto& node = p.node;
+  auto& cmds = p.cmds;
   auto drain = [&] { p.drain(); };
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
@@ -109,4 +115,36 @@ TEST(PilotNode, OneBogusStampIsHeldAndNeverMovesItsClock) {
   EXPECT_EQ(cmds.back().utime, 250000);
   EXPECT_EQ(node.pilot().state(), pilot::State::Takeoff);
   EXPECT_EQ(node.pilot().status().stale_holds, 0);
+}
+
+TEST(PilotNode, AgesEachTrackOnItsOwnClockWhenTheClocksAreComparable) {
+  // A frame 0.5 s old (a delayed link) is aged; one stamped 2 minutes from the node's clock
+  // is from another time base (a lock-step simulation, a replay) and is not.
+  PilotOnBus p;
+  auto& bus = p.bus;
+  auto& now_us = p.now_us;
+  auto& node = p.node;
+  auto& cmds = p.cmds;
+  aerie::track_t t{};
+  t.status = aerie::track_t::IDLE;
+  for (int k = 1; k <= 3; ++k) {
+    t.utime = 1'000'000'000 + k * 50000;
+    now_us = t.utime + 500000;
+    bus.publish("TRACK", t);
+    p.drain();
+  }
+  EXPECT_EQ(node.pilot().status().aged_results, 3);
+  for (int k = 4; k <= 6; ++k) {
+    t.utime = 1'000'000'000 + k * 50000;
+    now_us = t.utime + 120'000'000;
+    bus.publish("TRACK", t);
+    p.drain();
+  }
+  EXPECT_EQ(node.pilot().status().aged_results, 3);
+  t.utime += 50000;
+  now_us = t.utime + 100000;  // 0.1 s: within the limit
+  bus.publish("TRACK", t);
+  p.drain();
+  EXPECT_EQ(node.pilot().status().aged_results, 3);
+  EXPECT_EQ(cmds.size(), 7u);  // every TRACK answered, aged or not (lock-step)
 }
