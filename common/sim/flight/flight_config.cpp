@@ -18,7 +18,8 @@ MultirotorParams load_vehicle(const util::Config& c) {
           "hold_drift_m_per_sqrt_s", &M::hold_drift_m_per_sqrt_s)(
           "attitude_time_constant_s", &M::attitude_time_constant_s)("takeoff_height_m", &M::takeoff_height_m)(
           "takeoff_speed_m_s", &M::takeoff_speed_m_s)("land_speed_m_s", &M::land_speed_m_s)("radius_m", &M::radius_m)(
-          "max_touchdown_speed_m_s", &M::max_touchdown_speed_m_s)("command_timeout_s", &M::command_timeout_s)
+          "max_touchdown_speed_m_s", &M::max_touchdown_speed_m_s)("command_timeout_s", &M::command_timeout_s)(
+          "max_height_m", &M::max_height_m)
       .known("yaw_time_constant_s")
       .known("velocity_time_constant_s")
       .known("max_yaw_rate_deg_s")

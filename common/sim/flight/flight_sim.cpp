@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -168,6 +169,12 @@ FlightSim::FlightSim(const FlightSimConfig& config)
     airborne_ = true;
   }
   vehicle_ = Multirotor(cfg_.vehicle, start, mix_seed(cfg_.seed, 7006));
+  // The height fence over the ground it starts from; a room caps it so that the rotors stay
+  // 0.2 m below the ceiling (a blind climb, HOLD's and ABORT's, must not end on it).
+  double ceiling = cfg_.vehicle.max_height_m > 0 ? start_point->z() + cfg_.vehicle.max_height_m
+                                                 : std::numeric_limits<double>::infinity();
+  if (cfg_.world.kind == "room") ceiling = std::min(ceiling, world_.bounds().max.z() - 2 * cfg_.vehicle.radius_m - 0.2);
+  vehicle_.set_ceiling(ceiling);
   q_prev_ = start.pose().rotation();
 
   // Wind: steady part from a drawn direction, gusts from their stationary distribution.

@@ -57,6 +57,7 @@ void MultirotorParams::validate() const {
   need(takeoff_height_m > 0 && takeoff_speed_m_s > 0 && land_speed_m_s > 0, "take-off and landing figures must be > 0");
   need(radius_m > 0 && max_touchdown_speed_m_s > 0, "radius_m and max_touchdown_speed_m_s must be > 0");
   need(command_timeout_s >= 0, "command_timeout_s must be >= 0 (0 = never)");
+  need(max_height_m >= 0, "max_height_m must be >= 0 (0 = no height fence)");
 }
 
 geometry::SE3 MultirotorState::pose() const {
@@ -137,7 +138,8 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind, double
       v_cmd.z() = -p_.land_speed_m_s;
       break;
   }
-  // The autopilot's limits.
+  // The autopilot's limits: the height fence (climbs slow to a stop at it, 1/s), the speeds.
+  v_cmd.z() = std::min(v_cmd.z(), ceiling_z_ - s_.position.z());
   const double h = v_cmd.head<2>().norm();
   if (h > p_.max_horizontal_speed_m_s) v_cmd.head<2>() *= p_.max_horizontal_speed_m_s / h;
   v_cmd.z() = std::clamp(v_cmd.z(), -p_.max_vertical_speed_m_s, p_.max_vertical_speed_m_s);

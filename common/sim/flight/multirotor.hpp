@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -47,6 +48,10 @@ struct MultirotorParams {
   // position hold (PX4's COM_OF_LOSS_T, default 1 s), so a dead flight manager does not fly
   // the vehicle on its last command. 0 = never.
   double command_timeout_s = 1.0;
+  // The autopilot's height fence above the ground it started from (ArduPilot's FENCE_ALT_MAX,
+  // PX4's GF_MAX_VER_DIST): a climb slows to a stop there. 0 = none; in a room FlightSim
+  // caps it below the ceiling whatever it is.
+  double max_height_m = 0;
 
   // The two vehicle classes of docs/control.md, with the vertical loop and frame sizes.
   static MultirotorParams by_name(const std::string& name);  // "ardrone" | "pelican"; throws
@@ -89,6 +94,9 @@ class Multirotor {
   // The vehicle rests on a surface at height z_surface: vertical motion stops, and
   // horizontal motion and tilt too when disarmed.
   void set_contact(double z_surface);
+  // The highest world z the autopilot lets its feet climb to (the height fence); +inf = none.
+  void set_ceiling(double z) { ceiling_z_ = z; }
+  double ceiling() const { return ceiling_z_; }
 
   const MultirotorState& state() const { return s_; }
   const MultirotorParams& params() const { return p_; }
@@ -102,6 +110,7 @@ class Multirotor {
   std::deque<std::pair<double, AutopilotCommand>> pending_;  // (time it acts, command)
   AutopilotCommand active_;
   double takeoff_z_ = 0.0;
+  double ceiling_z_ = std::numeric_limits<double>::infinity();
   double active_since_s_ = 0.0;  // when the active command began to act
   int64_t command_timeouts_ = 0;
   Eigen::Vector3d velocity_integral_ = Eigen::Vector3d::Zero();  // m/s^2

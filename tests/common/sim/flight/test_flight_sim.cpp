@@ -2,6 +2,7 @@
 // collisions, refused commands, landing scores, determinism.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -134,6 +135,31 @@ TEST(FlightSim, FlyingIntoAWallIsACollisionNamedWithWhereItHappened) {
   EXPECT_TRUE(o.ended());
   EXPECT_NE(o.collision.find("rotor"), std::string::npos);
   EXPECT_FALSE(score_landing(sim).success);
+}
+
+TEST(FlightSim, ABlindClimbStopsAtTheHeightFenceBelowTheRoomsCeiling) {
+  // A pilot's HOLD and ABORT climb without knowing the height; in a 4 m room a link study
+  // flight climbed into the ceiling (docs/results/faults.md). The autopilot's fence stops it
+  // with the rotors 0.2 m below the ceiling, and max_height_m lowers it further.
+  for (const double max_height : {0.0, 2.5}) {
+    FlightSimConfig cfg = small_room();
+    cfg.vehicle.max_height_m = max_height;
+    FlightSim sim(cfg);
+    sim.step();
+    const double fence = max_height > 0 ? max_height : cfg.world.room_z - 2 * cfg.vehicle.radius_m - 0.2;
+    EXPECT_NEAR(sim.vehicle().ceiling(), fence, 1e-9);  // the room's floor is z = 0
+    sim.command(mode(kTakeoff));
+    fly_until(sim, 7.0);
+    double top = 0;
+    while (sim.time() < 20.0 && !sim.outcome().collided) {
+      sim.command(mode(kActive, 0, 0, 1.0));  // climb at 1 m/s, renewed every frame
+      sim.step();
+      top = std::max(top, sim.vehicle().state().position.z());
+    }
+    EXPECT_FALSE(sim.outcome().collided) << sim.outcome().collision;
+    EXPECT_LT(top, fence + 0.05);
+    EXPECT_NEAR(sim.vehicle().state().position.z(), fence, 0.02);
+  }
 }
 
 TEST(FlightSim, BadCommandsAreRefusedWithAReasonAndTheVehicleHolds) {

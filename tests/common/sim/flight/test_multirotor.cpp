@@ -2,6 +2,7 @@
 // the yaw sign convention, take-off and landing, wind rejection, the IMU at rest.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -83,6 +84,33 @@ TEST(Multirotor, AVelocityCommandNotRenewedBecomesAHoverAfterTheTimeout) {
   EXPECT_NEAR(m.state().velocity.norm(), 0.0, 0.02);
   // It flew on for the timeout and the braking, not for the 6 s.
   EXPECT_LT(m.state().position.x() - x_last, 1.0 * (p.base.command_delay_s + p.command_timeout_s) + 1.0);
+}
+
+TEST(Multirotor, AClimbSlowsToAStopAtTheHeightFence) {
+  MultirotorParams p = MultirotorParams::by_name("ardrone");
+  p.command_timeout_s = 0;
+  MultirotorState s;
+  s.position = {0, 0, 2};
+  s.armed = true;
+  s.on_ground = false;
+  Multirotor m(p, s);
+  m.set_ceiling(3.0);
+  AutopilotCommand up;
+  up.mode = AutopilotCommand::Mode::Velocity;
+  up.velocity = {0.5, 0, 1.0};  // forward and up: only the climb is fenced
+  m.command(0, up);
+  double t = 0, top = 0;
+  for (int i = 0; i < 2000; ++i, t += kDt) {
+    m.step(t, kDt, Eigen::Vector3d::Zero());
+    top = std::max(top, m.state().position.z());
+  }
+  EXPECT_LT(top, 3.0 + 0.06);  // the vertical loop's lag and integrator overshoot it by a few cm
+  EXPECT_NEAR(m.state().position.z(), 3.0, 0.01);
+  EXPECT_GT(m.state().velocity.x(), 0.3);
+  up.velocity = {0, 0, -0.5};  // descending is never fenced
+  m.command(t, up);
+  run(m, t, 3.0);
+  EXPECT_LT(m.state().position.z(), 2.0);
 }
 
 TEST(Multirotor, TakeoffClimbsToItsHeightAndLandDisarmsOnContact) {
