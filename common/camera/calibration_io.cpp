@@ -4,6 +4,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <opencv2/core/persistence.hpp>
 #include <sstream>
@@ -83,6 +84,9 @@ EurocCamera read_euroc_camera(const std::string& sensor_yaml) {
   if (model != "pinhole") fail(sensor_yaml, "camera_model must be 'pinhole', got '" + model + "'");
   const auto res = yaml_doubles(root, "resolution", sensor_yaml, 2);
   const auto intr = yaml_doubles(root, "intrinsics", sensor_yaml, 4);
+  for (int i = 0; i < 2; ++i)  // a size, not any double (4e56 would not fit an int)
+    if (!(res[i] >= 1 && res[i] <= 65535 && res[i] == std::floor(res[i])))
+      fail(sensor_yaml, "resolution must be two whole numbers in [1, 65535], got " + std::to_string(res[i]));
   cam.model.width = static_cast<int>(res[0]);
   cam.model.height = static_cast<int>(res[1]);
   cam.model.fx = intr[0];

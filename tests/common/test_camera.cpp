@@ -85,6 +85,18 @@ TEST(Calibration, BadInputsNameTheFileAndField) {
   }
   std::ofstream(dir / "calib.txt") << "700 0 600 0 0 700 180 0 0 0 1\n";
   EXPECT_THROW(read_kitti_stereo((dir / "calib.txt").string(), 100, 100), std::runtime_error);
+  // A resolution that is no image size (the fuzzer's 4.4e56 was cast to int: undefined).
+  for (const char* res : {"[752, 4.4e56]", "[-752, 480]", "[752.5, 480]", "[0, 480]"}) {
+    std::ofstream(dir / "sensor.yaml") << "%YAML:1.0\ncamera_model: pinhole\nresolution: " << res
+                                       << "\nintrinsics: [458, 457, 367, 248]\n"
+                                          "T_BS: {data: [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}\n";
+    try {
+      read_euroc_camera((dir / "sensor.yaml").string());
+      FAIL() << "resolution " << res << " accepted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("resolution must be two whole numbers"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Calibration, ProjectUnprojectRoundTrip) {
