@@ -55,8 +55,12 @@ void VoNode::check(const aerie::stereo_image_t& m) const {
     throw std::invalid_argument(what + "left/right/pair utimes " + std::to_string(m.left.utime) + " / " +
                                 std::to_string(m.right.utime) + " / " + std::to_string(m.utime) + " differ by more than " +
                                 std::to_string(cfg_.max_pair_skew_us) + " us");
-  if (!(m.fx > 0) || !(m.fy > 0) || !(m.baseline_m > 0) || !std::isfinite(m.cx) || !std::isfinite(m.cy))
-    throw std::invalid_argument(what + "fx, fy and baseline_m must be positive (rectified intrinsics)");
+  // Rectified intrinsics a camera can have (a corrupt 1e200 baseline is positive, too).
+  const double w = m.left.width, h = m.left.height;
+  if (!(m.fx > 0 && m.fx <= 1e5) || !(m.fy > 0 && m.fy <= 1e5) || !(m.baseline_m > 0 && m.baseline_m <= 100) ||
+      !(m.cx >= -w && m.cx <= 2 * w) || !(m.cy >= -h && m.cy <= 2 * h))
+    throw std::invalid_argument(what + "rectified intrinsics out of range: fx, fy must be in (0, 1e5] px, baseline_m in (0, 100] m, "
+                                       "cx, cy within one image size of the image");
 }
 
 void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
@@ -83,9 +87,23 @@ void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
   // A new camera (first pair, or size/intrinsics changed) or time going backwards (a log
   // replayed from the start): start over.
   const StereoCamera cam{m.fx, m.fy, m.cx, m.cy, m.baseline_m, left.cols, left.rows};
-  const bool new_camera = !vo_ || vo_->camera().width != cam.width || vo_->camera().height != cam.height ||
-                          vo_->camera().fx != cam.fx || vo_->camera().fy != cam.fy || vo_->camera().cx != cam.cx ||
-                          vo_->camera().cy != cam.cy || vo_->camera().baseline != cam.baseline;
+  auto same = [](const StereoCamera& a, const StereoCamera& b) {
+    return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
+           a.baseline == b.baseline;
+  };
+  const bool new_camera = !vo_ || !same(vo_->camera(), cam);
+  if (vo_ && new_camera) {
+    // Another camera than the running odometry's: one corrupt pair must not restart it;
+    // resync_messages pairs in a row with the same new camera do.
+    camera_run_ = pending_camera_ && same(*pending_camera_, cam) ? camera_run_ + 1 : 1;
+    pending_camera_ = cam;
+    if (camera_run_ < cfg_.message_time.resync_messages) {
+      status_.count("camera_change_pending");
+      return;
+    }
+  }
+  pending_camera_.reset();
+  camera_run_ = 0;
   try {
     if (new_camera) {
       if (vo_) spdlog::warn("camera changed on {}: restarting the odometry", cfg_.input);
@@ -107,9 +125,25 @@ void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
                    cam.height, cam.fx, cam.baseline, depth_size.width, depth_size.height, cfg_.vo.depth_every);
       status_.count("camera_changes");
     } else if (m.utime <= last_utime_ && time.verdict != util::MessageClock::Verdict::kResynced) {
+      // Not newer than the last pair. A copy of it (a duplicated or corrupted datagram) is
+      // dropped. An older one is dropped too, unless resync_messages older pairs come in a
+      // row, each newer than the one before: a new time base (a log replayed from its start),
+      // and the odometry starts over. One stray pair must not restart it: a burst of copies
+      // of one frame restarted it on every copy, and the avoidance manoeuvre lost its frame.
+      if (m.utime == last_utime_) {
+        status_.count("duplicate_pairs");
+        return;
+      }
+      older_run_ = older_run_ > 0 && m.utime > older_last_ ? older_run_ + 1 : 1;
+      older_last_ = m.utime;
+      if (older_run_ < cfg_.message_time.resync_messages) {
+        status_.count("out_of_order_pairs");
+        return;
+      }
       vo_->reset("time went back from " + std::to_string(last_utime_) + " to " + std::to_string(m.utime));
       status_.count("time_resets");
     }
+    older_run_ = 0;
     last_utime_ = m.utime;
     const VoResult r = vo_->process(left, right, m.utime);
     ++processed_;

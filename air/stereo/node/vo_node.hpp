@@ -64,6 +64,10 @@ class VoNode {
   std::unique_ptr<StereoOdometry> vo_;
   std::unique_ptr<spherical::SphericalEncoder> encoder_;
   int64_t last_utime_ = -1;
+  int older_run_ = 0;      // pairs older than last_utime_ in a row, each newer than the one before
+  int64_t older_last_ = 0;
+  std::optional<StereoCamera> pending_camera_;  // another camera than vo_'s, seen camera_run_ pairs in a row
+  int camera_run_ = 0;
   int64_t processed_ = 0, refused_ = 0, seq_ = 0;
   std::optional<VoResult> last_;
 };

@@ -96,10 +96,70 @@ TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
   EXPECT_EQ(node.processed(), 7);
   ASSERT_TRUE(node.last().has_value());
   EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
-  // Time going backwards (a replayed log) restarts the odometry and says so.
+  // Copies of the last pair (a burst of duplicated or corrupted datagrams) and one stray
+  // older pair are dropped and counted; the odometry goes on.
+  const aerie::stereo_image_t last_pair = to_message(f, K);
+  for (int i = 0; i < 30; ++i) node.on_stereo(last_pair, 0);
+  node.on_stereo(to_message(simulation.frame(2), K), 0);
+  EXPECT_EQ(status.counter("duplicate_pairs"), 30);
+  EXPECT_EQ(status.counter("out_of_order_pairs"), 1);
+  EXPECT_EQ(status.counter("time_resets"), 0);
+  EXPECT_EQ(node.processed(), 7);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  // Time going backwards for good (a log replayed from its start): the third older pair in
+  // a row, each newer than the one before, restarts the odometry and says so.
   node.on_stereo(to_message(simulation.frame(0), K), 0);
+  node.on_stereo(to_message(simulation.frame(1), K), 0);
+  EXPECT_EQ(node.processed(), 7);
+  node.on_stereo(to_message(simulation.frame(2), K), 0);
+  EXPECT_EQ(node.processed(), 8);
   EXPECT_EQ(node.last()->status, stereo::VoStatus::Reset);
   EXPECT_EQ(status.counter("time_resets"), 1);
+}
+
+TEST(VoNode, OneCorruptPairDoesNotRestartTheOdometryAPersistentNewCameraDoes) {
+  // A burst of bit-flipped pairs in an avoidance flight: a baseline of 2e+307 passed the
+  // "positive" check and restarted the odometry twice, and the flight lost its frame.
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "VO");
+  stereo::VoNodeConfig cfg;
+  cfg.vo.ba.enabled = false;
+  stereo::VoNode node(bus, status, cfg);
+  const sim::World world = sim::World::room(sim::WorldConfig{});
+  sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+  const auto K = simulation.intrinsics();
+  sim::StereoFrame f;
+  auto next = [&] {
+    simulation.next(f);
+    return to_message(f, K);
+  };
+  for (int i = 0; i < 6; ++i) node.on_stereo(next(), 0);
+  ASSERT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  aerie::stereo_image_t m = next();
+  m.baseline_m = 2e307;
+  node.on_stereo(m, 0);
+  m = next();
+  m.fx = 1e9;
+  node.on_stereo(m, 0);
+  EXPECT_EQ(status.counter("refused_pairs"), 2);
+  m = next();
+  m.fx *= 1.5;  // plausible, but another camera: once, then the real one again
+  node.on_stereo(m, 0);
+  node.on_stereo(next(), 0);
+  EXPECT_EQ(status.counter("camera_change_pending"), 1);
+  EXPECT_EQ(status.counter("camera_changes"), 1);  // the first camera only
+  EXPECT_EQ(node.processed(), 7);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
+  // The same new camera for resync_messages pairs in a row: the odometry starts over with it.
+  for (int i = 0; i < cfg.message_time.resync_messages; ++i) {
+    m = next();
+    m.fx *= 1.5;
+    node.on_stereo(m, 0);
+  }
+  EXPECT_EQ(status.counter("camera_change_pending"), cfg.message_time.resync_messages);
+  EXPECT_EQ(status.counter("camera_changes"), 2);
+  EXPECT_EQ(node.processed(), 8);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Initialising);
 }
 
 TEST(VoNode, OddImageSizesGiveDepthOnEveryDepthFrame) {
