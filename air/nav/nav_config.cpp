@@ -65,7 +65,10 @@ NavConfig load_nav_config(const util::Config& cfg) {
       "gyro_random_walk", &EskfParams::gyro_random_walk)("accel_noise_density", &EskfParams::accel_noise_density)(
       "accel_random_walk", &EskfParams::accel_random_walk)("max_dt_s", &EskfParams::max_imu_dt_s)(
       "max_gyro_rad_s", &EskfParams::max_gyro_rad_s)("max_accel_m_s2", &EskfParams::max_accel_m_s2)
+      .known("max_jump_s")
       .finish();
+  out.imu_max_jump_us = static_cast<int64_t>(
+      std::llround(cfg.section("imu").get_in("max_jump_s", out.imu_max_jump_us * 1e-6, 1e-6, 3600.0) * 1e6));
 
   struct Align {
     double window_s, max_gyro_std_rad_s, max_accel_std_m_s2, yaw_deg, position_sigma_m, velocity_sigma_m_s,

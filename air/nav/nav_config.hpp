@@ -16,6 +16,9 @@ struct NavConfig {
   // 1 s from the newest is held, so one bogus stamp never moves the filter's clock
   // (docs/architecture.md "Message time").
   util::MessageClockConfig message_time{1'000'000, 3, 2'000'000};
+  // The IMU's own bound (imu.max_jump_s), tighter: it comes at 200 Hz, and a bit-flipped
+  // stamp 0.9 s ahead, within the 1 s above, moved the filter's clock and lost the VO.
+  int64_t imu_max_jump_us = 200'000;
 };
 
 NavConfig load_nav_config(const util::Config& cfg);

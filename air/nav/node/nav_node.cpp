@@ -27,7 +27,8 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
       cfg_(std::move(config)),
       opt_(std::move(options)),
       eskf_(cfg_.eskf),
-      imu_time_(opt_.imu_channel, cfg_.message_time),
+      imu_time_(opt_.imu_channel, util::MessageClockConfig{cfg_.imu_max_jump_us, cfg_.message_time.resync_messages,
+                                                           cfg_.message_time.stale_timeout_us}),
       vo_time_(opt_.vo_channel, cfg_.message_time) {
   bus_.subscribe<aerie::imu_t>(opt_.imu_channel, [this](const aerie::imu_t& m, const bus::ReceiveInfo&) {
     if (!admit(imu_time_, opt_.imu_channel, m.utime)) return;
