@@ -5,7 +5,7 @@
 # real time under procman, as config/demo.pmd writes it: the simulated drone takes off in
 # the textured room, surveys, finds the helipad with its down camera, approaches, descends
 # on the tracker's 3D estimate and lands; VO and the map run on the forward stereo pair,
-# lcm-logger records everything into logs/demo-YYYYmmdd-HHMMSS.lcm, the viewer writes a
+# aerie-log record records everything into logs/demo-YYYYmmdd-HHMMSS.lcm, the viewer writes a
 # dashboard snapshot. It ends with one line (landed or not, touchdown error, time), the
 # log's summary (aerie-log info) and the files written. Ctrl-C stops the flight early; the
 # log is still closed and summarised. About a minute.

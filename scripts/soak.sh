@@ -3,7 +3,7 @@
 # again in real time by one long-running chain, its processes sampled once a second.
 #   bash scripts/soak.sh [--minutes N | --flights N] [--seed N] [--out DIR] [--warmup-minutes M]
 #                        [--netns] [--keep-log] [--bin DIR] [--recv-buf-size BYTES]
-# One deputy and one lcm-logger, aerie-map, aerie-viewer, aerie-vo and aerie-track run the
+# One deputy and one logger (aerie-log record), aerie-map, aerie-viewer, aerie-vo and aerie-track run the
 # whole time; each flight restarts aerie-pilot (its mission ends LANDED) and aerie-flightsim
 # with the next seed (--seed, then +1 per flight), through a headless sheriff per flight.
 # Between flights the tracker gets TRACK_CMD STOP, and INIT on the pad's box when it comes
@@ -16,7 +16,7 @@
 # summarised unless --keep-log. --netns runs it all in a private network namespace (root),
 # away from any other LCM traffic of the host. Ctrl-C stops early and still summarises.
 # --recv-buf-size gives every node's LCM socket that receive buffer (recv_buf_size in
-# LCM_DEFAULT_URL; the demo gives it to lcm-logger only), to compare the drops.
+# LCM_DEFAULT_URL; the demo gives it to the logger only), to compare the drops.
 # Builds nothing when the binaries exist (else scripts/build.sh); --bin takes the nodes from
 # another build's bin/ (the suite's smoke test). Exit 0 when every flight landed within the
 # success bounds and the logger lost nothing.
@@ -61,7 +61,7 @@ fi
 # Python with matplotlib (scripts/setup.sh installs Debian's): /usr/bin/python3 before another on PATH.
 PY=python3
 [ -x /usr/bin/python3 ] && PY=/usr/bin/python3
-for tool in lcm-logger lcm-gen "$PY" Xvfb; do
+for tool in lcm-gen "$PY" Xvfb; do
   command -v "$tool" >/dev/null || { echo "soak: '$tool' is missing (bash scripts/setup.sh)" >&2; exit 1; }
 done
 

@@ -50,12 +50,11 @@ die() { echo "split-demo: $*" >&2; exit 1; }
 [[ $(id -u) -eq 0 ]] || die "needs root for network namespaces (sudo $0 ...)"
 command -v ip >/dev/null || die "iproute2 'ip' is missing (apt-get install iproute2)"
 [[ -f $CONFIG ]] || die "no procman config '$CONFIG' (run from the repository root)"
-needed=(aerie-deputy aerie-sheriff aerie-latency aerie-capture)
+needed=(aerie-deputy aerie-sheriff aerie-latency aerie-capture aerie-log)
 [[ $LINK -eq 1 ]] && needed+=(aerie-link)
 for exe in "${needed[@]}"; do
   [[ -x $BIN/$exe ]] || die "$BIN/$exe not found: build first (bash scripts/build.sh) or give --bin"
 done
-command -v lcm-logger >/dev/null || die "lcm-logger is missing (apt-get install liblcm-bin)"
 
 BIN=$(cd "$BIN" && pwd)
 AIR=aerie-split-$$-air

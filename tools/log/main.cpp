@@ -3,6 +3,7 @@
 //   aerie-log export LOG --channel C --out DIR [--resync] [--force]
 //   aerie-log cut LOG --from S --to S --out LOG2 [--exclude REGEX] [--resync] [--force]
 //   aerie-log diff A B [--channels C1,C2,...]
+//   aerie-log record LOG [--channels REGEX] [--queue N] [--lcm-url URL] [--duration S] [--force]
 // Exit status: 0 ok, 1 error (bad arguments, missing file/channel), 2 the log is
 // damaged (everything before the damage was still processed, and it is reported).
 // diff, as cmp(1): 0 the logs hold the same messages, 1 they differ, 2 usage error or a log
@@ -15,9 +16,34 @@
 #include "tools/log/log_cut.hpp"
 #include "tools/log/log_diff.hpp"
 #include "tools/log/log_export.hpp"
+#include "common/bus/node.hpp"
+#include "common/util/time.hpp"
 #include "tools/log/log_info.hpp"
+#include "tools/log/log_record.hpp"
 
 namespace {
+
+// Records until SIGINT/SIGTERM or `duration_s`; what liblcm still holds is written before the
+// file is closed, so a Ctrl-C loses nothing that was received.
+int record(aerie::logtools::RecordOptions options, const std::string& url, double duration_s) {
+  aerie::bus::install_stop_handlers();
+  aerie::bus::Bus bus(url);
+  const int queue = options.queue;
+  aerie::logtools::Recorder recorder(bus, std::move(options));
+  std::cerr << "aerie-log record: recording " << recorder.path() << " (queue " << queue << " messages)\n";
+  const int64_t t0 = aerie::util::wall_utime();
+  const auto elapsed_s = [&] { return (aerie::util::wall_utime() - t0) * 1e-6; };
+  while (!aerie::bus::stop_requested() && (duration_s <= 0 || elapsed_s() < duration_s)) {
+    bus.handle(50);
+    recorder.tick(aerie::util::wall_utime());
+  }
+  while (bus.handle(0) > 0) {
+  }
+  recorder.close();
+  std::cerr << "aerie-log record: " << recorder.events() << " events, " << recorder.bytes() / 1e6 << " MB in "
+            << elapsed_s() << " s to " << recorder.path() << "\n";
+  return 0;
+}
 
 int report_damage(const std::vector<aerie::logio::Damage>& damage) {
   for (const auto& d : damage) std::cerr << "aerie-log: DAMAGE: " << d.message << "\n";
@@ -69,6 +95,24 @@ int main(int argc, char** argv) {
                "Exit status: 0 every compared channel is identical (same counts, every message identical), "
                "1 they differ, 2 usage error or a log that cannot be read or is damaged.");
 
+  aerie::logtools::RecordOptions rec_opt;
+  std::string url;
+  double duration_s = 0;
+  auto* rec = app.add_subcommand("record", "Record the LCM network into a log (lcm-logger's format) with a receive "
+                                           "queue deep enough for a loaded machine; Ctrl-C closes it");
+  rec->add_option("log", rec_opt.path, "LCM log file to write")->required();
+  rec->add_option("--channels", rec_opt.channels, "LCM channel regular expression")->capture_default_str();
+  rec->add_option("--queue", rec_opt.queue,
+                  "messages liblcm keeps for the recorder while it writes (lcm-logger: 30); 0 = no limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10'000'000));
+  rec->add_option("--lcm-url", url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  rec->add_option("--duration", duration_s, "stop after this many seconds (default: until SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  rec->add_flag("--force", rec_opt.force, "Overwrite an existing log (refused otherwise)");
+  rec->footer("Event times are the receive times, as lcm-logger writes them; lcm-logplayer replays the log. "
+              "The file is flushed every 0.1 s.");
+
   for (auto* sub : {info, exp, cut})
     sub->add_flag("--resync", resync, "Skip damaged bytes to the next event header instead of stopping there");
   for (auto* sub : {exp, cut})
@@ -91,6 +135,7 @@ int main(int argc, char** argv) {
     }
   }
   try {
+    if (*rec) return record(rec_opt, url, duration_s);
     if (*info) {
       const auto s = aerie::logtools::summarize(log, resync);
       if (json) {

@@ -28,7 +28,7 @@ from collections import defaultdict
 TARGET_GROWTH = 0.05
 # What each procman command of config/demo.pmd runs (for the tables).
 PROGRAM = {"flightsim": "aerie-flightsim", "track": "aerie-track", "pilot": "aerie-pilot", "vo": "aerie-vo",
-           "map": "aerie-map", "logger": "lcm-logger", "viewer": "aerie-viewer", "deputy": "aerie-deputy",
+           "map": "aerie-map", "logger": "aerie-log record", "viewer": "aerie-viewer", "deputy": "aerie-deputy",
            "xvfb": "Xvfb", "soak-monitor": "soak_monitor.py"}
 ORDER = ["flightsim", "pilot", "track", "vo", "map", "logger", "viewer", "deputy", "xvfb", "soak-monitor"]
 # Counters worth a column: errors, drops and skips (cumulative, per process).

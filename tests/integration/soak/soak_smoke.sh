@@ -7,11 +7,11 @@
 # counters of every Aerie node, the logger's losses counted (log-info.json), soak.md with its
 # tables, and the plots when matplotlib is there. The landing itself is not required (a
 # loaded machine may miss frames; tests/integration/landing checks landings in lock-step),
-# but is printed. Exit 77 (skipped) without root, ip, Xvfb or lcm-logger.
+# but is printed. Exit 77 (skipped) without root, ip or Xvfb.
 set -uo pipefail
 src="$1" bin="$2" work="$3"
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: the soak's --netns needs root (ip netns add)"; exit 77; }
-for t in ip Xvfb lcm-logger lcm-gen; do
+for t in ip Xvfb lcm-gen; do
   command -v "$t" >/dev/null 2>&1 || { echo "SKIP: '$t' is not installed (scripts/setup.sh)"; exit 77; }
 done
 rm -rf "$work"
