@@ -27,8 +27,9 @@ bool traverse_keys(const Eigen::Vector3d& origin, const Eigen::Vector3d& directi
   double t_max[3], t_delta[3];
   for (int i = 0; i < 3; ++i) {
     const double u = origin[i] / resolution + kKeyCentre;
-    c[i] = static_cast<long>(std::floor(u / cell));
-    if (c[i] < 0 || c[i] >= n_cells) return false;
+    const double ci = std::floor(u / cell);
+    if (!(ci >= 0 && ci < static_cast<double>(n_cells))) return false;  // also NaN; checked before the cast (1e159 overflowed it)
+    c[i] = static_cast<long>(ci);
     const double du = direction[i] / resolution;  // key units per metre
     if (du > 0) {
       step[i] = 1;

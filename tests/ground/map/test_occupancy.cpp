@@ -364,3 +364,19 @@ TEST(KeyRay, SameVoxelsAsOctoMapComputeRayKeys) {
   // Both are Amanatides & Woo; ties at voxel corners may be broken differently.
   EXPECT_LE(differing, rays / 50) << differing << " of " << rays;
 }
+
+TEST(KeyRay, AnOriginOutsideTheKeyRangeIsRefusedBeforeAnyCast) {
+  // A MAP_QUERY ray from x = 4.4e159 (the map fuzzer's input): the key was cast to long
+  // first, which is undefined for such a double. Now it is out of the key range: false.
+  int visited = 0;
+  auto visit = [&](const octomap::OcTreeKey&, double, double) {
+    ++visited;
+    return true;
+  };
+  EXPECT_FALSE(m::traverse_keys(Vector3d(4.4e159, 0, 0), Vector3d(1, 0, 0), 1.0, 0.1, 0, visit));
+  EXPECT_FALSE(m::traverse_keys(Vector3d(0, -1e300, 0), Vector3d(0, 1, 0), 1.0, 0.1, 3, visit));
+  EXPECT_FALSE(m::traverse_keys(Vector3d(0, 0, std::nan("")), Vector3d(0, 0, 1), 1.0, 0.1, 0, visit));
+  EXPECT_EQ(visited, 0);
+  EXPECT_TRUE(m::traverse_keys(Vector3d(0.05, 0.05, 0.05), Vector3d(1, 0, 0), 0.25, 0.1, 0, visit));
+  EXPECT_EQ(visited, 3);  // [0, 0.1), [0.1, 0.2), [0.2, 0.3)
+}
