@@ -3,20 +3,21 @@
 # again in real time by one long-running chain, its processes sampled once a second.
 #   bash scripts/soak.sh [--minutes N | --flights N] [--seed N] [--out DIR] [--warmup-minutes M]
 #                        [--netns] [--keep-log] [--bin DIR] [--recv-buf-size BYTES]
-# One deputy and one logger (aerie-log record), aerie-map, aerie-viewer, aerie-vo and aerie-track run the
-# whole time; each flight restarts aerie-pilot (its mission ends LANDED) and aerie-flightsim
-# with the next seed (--seed, then +1 per flight), through a headless sheriff per flight.
-# Between flights the tracker gets TRACK_CMD STOP, and INIT on the pad's box when it comes
-# into view (the operator's box), and the map MAP_CMD CLEAR (VO restarts its frame with each
-# flight): tools/soak/soak_monitor.py, which also samples RSS, CPU and STATUS_* counters. Flights start until N minutes (default 30, fractions allowed) have
+# One deputy and one logger (aerie-log record), aerie-map, aerie-viewer, aerie-vo and
+# aerie-track run the whole time; each flight restarts aerie-pilot (its mission ends LANDED)
+# and aerie-flightsim with the next seed (--seed, then +1 per flight), through a headless
+# sheriff per flight. Between flights the tracker gets TRACK_CMD STOP, and INIT on the pad's
+# box when it comes into view (the operator's box), and the map MAP_CMD CLEAR (VO restarts
+# its frame with each flight): tools/soak/soak_monitor.py, which also samples RSS, CPU and
+# STATUS_* counters. Flights start until N minutes (default 30, fractions allowed) have
 # passed, or N flights have flown; the last one lands first. At the end: the logger's losses
 # (aerie-log info on the whole log), per-node RSS growth after the warm-up (default 3 min,
 # at most a third of the run), CPU, landings, and rss.png / cpu.png, in OUT/soak.md
 # (OUT default logs/soak-YYYYmmdd-HHMMSS). The log (~0.3 GB a minute) is deleted once
 # summarised unless --keep-log. --netns runs it all in a private network namespace (root),
 # away from any other LCM traffic of the host. Ctrl-C stops early and still summarises.
-# --recv-buf-size gives every node's LCM socket that receive buffer (recv_buf_size in
-# LCM_DEFAULT_URL; the demo gives it to the logger only), to compare the drops.
+# --recv-buf-size gives every node's LCM socket another receive buffer (recv_buf_size in
+# LCM_DEFAULT_URL; scripts/local-lcm.sh gives 4 MiB), to compare the drops.
 # Builds nothing when the binaries exist (else scripts/build.sh); --bin takes the nodes from
 # another build's bin/ (the suite's smoke test). Exit 0 when every flight landed within the
 # success bounds and the logger lost nothing.
