@@ -157,6 +157,14 @@ class SaturatedFreeBricks {
   std::vector<size_t> looked_up_;
 };
 
+// OctoMap's coordToKeyChecked casts resolution_factor * coordinate to int before its range
+// check: undefined for a coordinate far outside the tree (the map fuzzer's MAP_QUERY at
+// x = 4.4e159). The tree spans [-resolution 2^15, resolution 2^15) per axis: checked first.
+bool to_key(const MapTree& tree, const Eigen::Vector3d& p, octomap::OcTreeKey& key) {
+  const double half = tree.getResolution() * kKeyCentre;
+  return p.allFinite() && (p.array().abs() < half).all() && tree.coordToKeyChecked(p.x(), p.y(), p.z(), key);
+}
+
 }  // namespace
 
 // Per-frame scratch, kept between frames to avoid reallocation.
@@ -250,7 +258,7 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
   const MapTree& tree = *tree_;
   const Eigen::Vector3d origin = origin_f.cast<double>();
   octomap::OcTreeKey origin_key;
-  require(origin.allFinite() && tree.coordToKeyChecked(origin.x(), origin.y(), origin.z(), origin_key),
+  require(to_key(tree, origin, origin_key),
           "sensor origin is not finite or outside the map's key range");
   const double max_range = params_.sensor_model.max_range;
   const double res = params_.resolution;
@@ -276,7 +284,7 @@ FrameStats OccupancyMap::insert(const std::vector<Eigen::Vector3f>& points, cons
       ++stats.beyond_range;
     }
     octomap::OcTreeKey key;
-    if (!tree.coordToKeyChecked(p.x(), p.y(), p.z(), key)) {
+    if (!to_key(tree, p, key)) {
       ++stats.out_of_bounds;
       continue;
     }
@@ -389,7 +397,7 @@ VoxelQuery OccupancyMap::occupancy(const Eigen::Vector3d& p, unsigned depth) con
   const unsigned d = depth == 0 ? tree_depth : depth;
   q.voxel_size = tree_->getNodeSize(d);
   octomap::OcTreeKey key;
-  if (!p.allFinite() || !tree_->coordToKeyChecked(p.x(), p.y(), p.z(), key)) return q;
+  if (!to_key(*tree_, p, key)) return q;
   const octomap::OcTreeKey cell = tree_->adjustKeyAtDepth(key, d);
   const auto c = tree_->keyToCoord(cell, d);
   q.center = {c.x(), c.y(), c.z()};

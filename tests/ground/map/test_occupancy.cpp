@@ -380,3 +380,14 @@ TEST(KeyRay, AnOriginOutsideTheKeyRangeIsRefusedBeforeAnyCast) {
   EXPECT_TRUE(m::traverse_keys(Vector3d(0.05, 0.05, 0.05), Vector3d(1, 0, 0), 0.25, 0.1, 0, visit));
   EXPECT_EQ(visited, 3);  // [0, 0.1), [0.1, 0.2), [0.2, 0.3)
 }
+
+TEST(Occupancy, APointFarOutsideTheTreeIsUnknownWithoutReachingOctoMapsCast) {
+  // OctoMap's coordToKeyChecked casts before it checks: a MAP_QUERY at x = 4.4e159 was
+  // undefined behaviour there (the map fuzzer, after the ray fix above).
+  m::OccupancyMap map(exact_params());
+  map.insert_frame({{2.05f, 0.05f, 0.05f}}, {0.05f, 0.05f, 0.05f});
+  for (const Vector3d& p : {Vector3d(4.4e159, 0, 0), Vector3d(0, -1e300, 0), Vector3d(0, 0, 1e10)})
+    EXPECT_EQ(map.occupancy(p).state, m::Occupancy::Unknown);
+  EXPECT_EQ(map.occupancy({2.05, 0.05, 0.05}).state, m::Occupancy::Occupied);
+  EXPECT_THROW(map.insert_frame({{0.f, 0.f, 0.f}}, {3e38f, 0.f, 0.f}), std::invalid_argument);
+}
