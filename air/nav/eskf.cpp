@@ -90,6 +90,13 @@ Eskf::Eskf(EskfParams params) : p_(std::move(params)) { p_.validate(); }
 // IMU
 
 Outcome Eskf::add_imu(const ImuSample& s) {
+  // Message time is microseconds since an epoch: never negative. Refusing it keeps every
+  // difference of two accepted times inside int64 (a first sample at INT64_MIN made the next
+  // gap overflow: the nav fuzzer).
+  if (s.utime < 0) {
+    ++counters_.imu_negative_time;
+    return refuse("IMU sample at utime " + utime_str(s.utime) + ": negative time");
+  }
   if (!s.gyro.allFinite() || !s.accel.allFinite()) {
     ++counters_.imu_non_finite;
     return refuse("IMU sample at utime " + utime_str(s.utime) + ": non-finite gyro or accel (NaN/Inf)");

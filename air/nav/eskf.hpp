@@ -118,6 +118,7 @@ struct Outcome {
 
 struct EskfCounters {
   int64_t imu_accepted = 0, imu_non_finite = 0, imu_out_of_range = 0, imu_time_not_increasing = 0, imu_gaps = 0;
+  int64_t imu_negative_time = 0;
   int64_t static_windows_rejected = 0;  // alignment windows that were not still
   int64_t vo_applied = 0, vo_gated = 0, vo_anchors = 0;  // per VO pose, its latest outcome
   int64_t vo_invalid = 0, vo_too_old = 0, vo_duplicate = 0, vo_before_alignment = 0, vo_pending_dropped = 0;

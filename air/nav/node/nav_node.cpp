@@ -162,6 +162,7 @@ void NavNode::report(bus::StatusReporter& status) const {
   const EskfCounters& c = eskf_.counters();
   status.set("imu_accepted", c.imu_accepted);
   status.set("imu_non_finite", c.imu_non_finite);
+  status.set("imu_negative_time", c.imu_negative_time);
   status.set("imu_out_of_range", c.imu_out_of_range);
   status.set("imu_time_not_increasing", c.imu_time_not_increasing);
   status.set("imu_gaps", c.imu_gaps);

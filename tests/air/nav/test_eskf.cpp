@@ -374,6 +374,15 @@ TEST(Eskf, BadImuIsRefusedAndCounted) {
   ImuSample wild = exact_imu(0.505, utime_of(0.505));
   wild.gyro.z() = 100.0;
   EXPECT_FALSE(f.add_imu(wild).accepted);
+  ImuSample negative = exact_imu(0.505, std::numeric_limits<int64_t>::min());  // the nav fuzzer's first sample
+  o = f.add_imu(negative);
+  EXPECT_FALSE(o.accepted);
+  EXPECT_NE(o.reason.find("negative time"), std::string::npos) << o.reason;
+  Eskf fresh(p);  // before the alignment too: a negative first sample never becomes the time reference
+  EXPECT_FALSE(fresh.add_imu(negative).accepted);
+  EXPECT_TRUE(fresh.add_imu(exact_imu(0.0, utime_of(0.0))).accepted);
+  EXPECT_EQ(fresh.counters().imu_negative_time, 1);
+  EXPECT_EQ(f.counters().imu_negative_time, 1);
   EXPECT_EQ(f.counters().imu_non_finite, 2);
   EXPECT_EQ(f.counters().imu_time_not_increasing, 2);
   EXPECT_EQ(f.counters().imu_out_of_range, 1);
