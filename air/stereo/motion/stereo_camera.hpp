@@ -14,6 +14,7 @@ struct StereoCamera {
   double baseline = 0;  // metres
   int width = 0, height = 0;
 
+  bool operator==(const StereoCamera&) const = default;
   void validate(const std::string& what = "stereo camera") const {
     if (!(fx > 0) || !(fy > 0) || !(baseline > 0) || width <= 0 || height <= 0)
       throw std::invalid_argument(what + ": fx, fy, baseline, width and height must be positive");

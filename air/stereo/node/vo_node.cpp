@@ -87,15 +87,11 @@ void VoNode::on_stereo(const aerie::stereo_image_t& m, int64_t receive_utime) {
   // A new camera (first pair, or size/intrinsics changed) or time going backwards (a log
   // replayed from the start): start over.
   const StereoCamera cam{m.fx, m.fy, m.cx, m.cy, m.baseline_m, left.cols, left.rows};
-  auto same = [](const StereoCamera& a, const StereoCamera& b) {
-    return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy &&
-           a.baseline == b.baseline;
-  };
-  const bool new_camera = !vo_ || !same(vo_->camera(), cam);
+  const bool new_camera = !vo_ || vo_->camera() != cam;
   if (vo_ && new_camera) {
     // Another camera than the running odometry's: one corrupt pair must not restart it;
     // resync_messages pairs in a row with the same new camera do.
-    camera_run_ = pending_camera_ && same(*pending_camera_, cam) ? camera_run_ + 1 : 1;
+    camera_run_ = pending_camera_ == cam ? camera_run_ + 1 : 1;
     pending_camera_ = cam;
     if (camera_run_ < cfg_.message_time.resync_messages) {
       status_.count("camera_change_pending");
