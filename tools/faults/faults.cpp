@@ -76,7 +76,7 @@ Fault parse(const std::string& spec) {
   const bool has_duration = f.kind == Kind::Kill || f.kind == Kind::CameraStall || f.kind == Kind::LinkDrop ||
                             f.kind == Kind::LinkDegrade;
   if (has_duration != (plus != std::string::npos))
-    throw std::invalid_argument("fault '" + spec + "': " + name + (has_duration ? " needs" : " takes no") + " a duration (+D)");
+    throw std::invalid_argument("fault '" + spec + "': " + name + (has_duration ? " needs a duration (+D)" : " takes no duration (+D)"));
   if (has_duration) {
     f.duration_s = number(spec, "the duration", fields[0].substr(plus + 1));
     if (f.duration_s <= 0) throw std::invalid_argument("fault '" + spec + "': the duration must be > 0");
@@ -174,55 +174,48 @@ void Injector::step(double t_s, Flight& flight) {
     const Fault& f = faults_[i];
     if (phase_[i] == 0 && t_s + 1e-9 >= f.at_s) {
       phase_[i] = f.duration_s > 0 ? 1 : 2;
-      switch (f.kind) {
-        case Kind::Kill: {
-          const auto node = flight.nodes.find(f.target);
-          if (node == flight.nodes.end()) {
-            std::string names;
-            for (const auto& [n, _] : flight.nodes) names += (names.empty() ? "" : ", ") + n;
-            throw std::invalid_argument("fault '" + to_string(f) + "': this flight has no node '" + f.target + "' (" + names + ")");
-          }
-          node->second(false);
-          ++counters_.kills;
-          break;
-        }
-        case Kind::CameraStall: flight.stall_cameras(true); break;
-        case Kind::LinkDrop:
-          for (auto* d : directions(flight)) d->set_down(true);
-          break;
-        case Kind::LinkDegrade:
-          for (auto* d : directions(flight)) d->impair(f.delay_ms, f.loss);
-          break;
-        case Kind::Burst:
-          burst(link::Side::kAir, f.count, flight.buses->on(link::Side::kAir));
-          if (flight.buses->link()) burst(link::Side::kGround, f.count, flight.buses->on(link::Side::kGround));
-          break;
-        case Kind::NanPose: nan_pose(f.target, flight); break;
-      }
+      set(f, flight, true);
     }
     if (phase_[i] == 1 && t_s + 1e-9 >= f.at_s + f.duration_s) {
       phase_[i] = 2;
-      switch (f.kind) {
-        case Kind::Kill:
-          flight.nodes.at(f.target)(true);
-          ++counters_.respawns;
-          break;
-        case Kind::CameraStall: flight.stall_cameras(false); break;
-        case Kind::LinkDrop:
-          for (auto* d : directions(flight)) d->set_down(false);
-          break;
-        case Kind::LinkDegrade:  // back to the link's configured figures
-          for (auto* d : directions(flight)) d->restore();
-          break;
-        default: break;
-      }
+      set(f, flight, false);
     }
   }
 }
 
-// Malformed messages as a hostile or broken sender makes them (issue 19's campaigns), in
-// turn: random bytes, a truncated message, bit flips, and hostile 32-bit values (negative
-// or huge length prefixes) written over a real message, spread over every channel seen.
+void Injector::set(const Fault& f, Flight& flight, bool on) {
+  switch (f.kind) {
+    case Kind::Kill: {
+      const auto node = flight.nodes.find(f.target);
+      if (node == flight.nodes.end()) {
+        std::string names;
+        for (const auto& [n, _] : flight.nodes) names += (names.empty() ? "" : ", ") + n;
+        throw std::invalid_argument("fault '" + to_string(f) + "': this flight has no node '" + f.target + "' (" + names + ")");
+      }
+      node->second(!on);  // killed while the fault lasts, respawned when it ends
+      ++(on ? counters_.kills : counters_.respawns);
+      break;
+    }
+    case Kind::CameraStall: flight.stall_cameras(on); break;
+    case Kind::LinkDrop:
+      for (auto* d : directions(flight)) d->set_down(on);
+      break;
+    case Kind::LinkDegrade:  // ends back at the link's configured figures
+      for (auto* d : directions(flight)) {
+        if (on)
+          d->impair(f.delay_ms, f.loss);
+        else
+          d->restore();
+      }
+      break;
+    case Kind::Burst:  // instantaneous: only started
+      burst(link::Side::kAir, f.count, flight.buses->on(link::Side::kAir));
+      if (flight.buses->link()) burst(link::Side::kGround, f.count, flight.buses->on(link::Side::kGround));
+      break;
+    case Kind::NanPose: nan_pose(f.target, flight); break;
+  }
+}
+
 void Injector::burst(link::Side side, int count, bus::Bus& bus) {
   std::vector<const std::pair<const std::pair<link::Side, std::string>, std::vector<uint8_t>>*> seen;
   for (const auto& e : last_)

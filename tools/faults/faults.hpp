@@ -127,6 +127,8 @@ class Injector {
   std::string applied() const;  // the faults with their times drawn, as specs
 
  private:
+  // Starts (on) or ends a fault; instantaneous ones (burst, NaN pose) only start.
+  void set(const Fault& f, Flight& flight, bool on);
   void burst(link::Side side, int count, bus::Bus& bus);
   void nan_pose(const std::string& channel, Flight& flight);
   static std::vector<link::LinkDirection*> directions(Flight& flight);

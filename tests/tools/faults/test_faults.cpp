@@ -73,7 +73,7 @@ TEST(FaultSpec, BadSpecsAreRefusedNamingWhatIsWrong) {
   EXPECT_NE(refusal("explode@8").find("unknown kind 'explode'"), std::string::npos);
   EXPECT_NE(refusal("camera_stall@8").find("needs a duration"), std::string::npos);
   EXPECT_NE(refusal("burst@8").find("burst@T:COUNT"), std::string::npos);
-  EXPECT_NE(refusal("burst@8+1:10").find("takes no a duration"), std::string::npos);
+  EXPECT_NE(refusal("burst@8+1:10").find("takes no duration"), std::string::npos);
   EXPECT_NE(refusal("link_degrade@8+5:500:1.5").find("loss must be in [0, 1]"), std::string::npos);
   EXPECT_NE(refusal("kill:track@-1+1").find("start time must be a number >= 0, got '-1'"), std::string::npos);
   EXPECT_NE(refusal("camera_stall@9~3+1").find("ends before it starts"), std::string::npos);
