@@ -341,11 +341,12 @@ namespace {
 struct LockStep {
   bus::Bus bus{"memq://"};
   bus::StatusReporter status{bus, "control"};
-  int64_t now = 1'000'000'000;
+  int64_t now;
   ControlNode node;
   std::vector<aerie::control_cmd_t> cmds;
 
-  explicit LockStep(NodeOptions opt = {}) : node(bus, status, tuned(), opt, [this] { return now; }) {
+  explicit LockStep(NodeOptions opt = {}, int64_t start_us = 1'000'000'000)
+      : now(start_us), node(bus, status, tuned(), opt, [this] { return now; }) {
     bus.subscribe<aerie::control_cmd_t>("CTRL_CMD",
                                         [this](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
   }
@@ -492,13 +493,8 @@ TEST(HeadingFromPose, NavStateBodyAxisAndConfiguredAxis) {
 TEST(ControlNode, NavStateInputOneCommandPerMessage) {
   // rate_hz 0: every NAV_STATE is answered by one command carrying its utime (lock-step,
   // replay); INITIALISING and LOST states are counted and answered by hover / fallback.
-  const NodeOptions opt = nav_avoidance_options();
-  bus::Bus bus("memq://");
-  bus::StatusReporter status(bus, "control");
-  int64_t now = 0;
-  ControlNode node(bus, status, tuned(), opt, [&now] { return now; });
-  std::vector<aerie::control_cmd_t> cmds;
-  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  LockStep s(nav_avoidance_options(), 0);
+  auto& [bus, status, now, node, cmds] = s;
   bus.publish("NAV_STATE", nav_state(0, aerie::nav_state_t::INITIALISING, 0));
   for (int k = 1; k <= 30; ++k) {
     now = k * 5'000;
@@ -525,14 +521,9 @@ TEST(ControlNode, NavStateInputOneCommandPerMessage) {
 TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
   // The fault campaign (docs/faults.md): a respawned aerie-nav starts a new frame, a respawned
   // aerie-control would re-anchor the manoeuvre where the vehicle is; both flew into the wall.
-  const NodeOptions opt = nav_avoidance_options();
   for (const bool restarted_nav : {true, false}) {
-    bus::Bus bus("memq://");
-    bus::StatusReporter status(bus, "control");
-    int64_t now = 0;
-    ControlNode node(bus, status, tuned(), opt, [&now] { return now; });
-    std::vector<aerie::control_cmd_t> cmds;
-    bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+    LockStep s(nav_avoidance_options(), 0);
+    auto& [bus, status, now, node, cmds] = s;
     // Nav restarted (OK, then INITIALISING, then OK in its new frame); or a control started
     // in flight, its first pose 2 m from the frame's origin.
     const double x0 = restarted_nav ? 0.0 : 2.0;

@@ -39,9 +39,7 @@ struct PilotOnBus {
 
 TEST(PilotNode, AnswersEachTrackAndCountsBadInputs) {
   PilotOnBus p;
-  auto& bus = p.bus;
-  auto& node = p.node;
-  auto& cmds = p.cmds;
+  auto& [bus, now_us, node, cmds] = p;
   auto drain = [&] { p.drain(); };
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
@@ -84,9 +82,7 @@ TEST(PilotNode, OneBogusStampIsHeldAndNeverMovesItsClock) {
   // A corrupt or hostile message stamped far from its source's time (fault campaign: a
   // bit-flipped IMU stamp made the pilot see its tracker silent for 1.4e8 s and abort).
   PilotOnBus p;
-  auto& bus = p.bus;
-  auto& node = p.node;
-  auto& cmds = p.cmds;
+  auto& [bus, now_us, node, cmds] = p;
   auto drain = [&] { p.drain(); };
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
@@ -121,10 +117,7 @@ TEST(PilotNode, AgesEachTrackOnItsOwnClockWhenTheClocksAreComparable) {
   // A frame 0.5 s old (a delayed link) is aged; one stamped 2 minutes from the node's clock
   // is from another time base (a lock-step simulation, a replay) and is not.
   PilotOnBus p;
-  auto& bus = p.bus;
-  auto& now_us = p.now_us;
-  auto& node = p.node;
-  auto& cmds = p.cmds;
+  auto& [bus, now_us, node, cmds] = p;
   aerie::track_t t{};
   t.status = aerie::track_t::IDLE;
   for (int k = 1; k <= 3; ++k) {

@@ -30,6 +30,20 @@ aerie::stereo_image_t to_message(const sim::StereoFrame& f, const sim::Intrinsic
   return m;
 }
 
+// The survey every test flies: the standard room, one loop at 1 m/s, 20 pairs a second
+// (the world outlives the simulation that refers to it).
+struct Survey {
+  const sim::World world = sim::World::room(sim::WorldConfig{});
+  sim::StereoSimulation simulation{world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0};
+};
+
+// The node without its bundle-adjuster thread: every pose is the front end's, at once.
+stereo::VoNodeConfig without_ba() {
+  stereo::VoNodeConfig cfg;
+  cfg.vo.ba.enabled = false;
+  return cfg;
+}
+
 }  // namespace
 
 TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
@@ -40,12 +54,11 @@ TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
   bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t& p, const bus::ReceiveInfo&) { poses.push_back(p); });
   bus.subscribe<aerie::spherical_depth_t>("VO_DEPTH",
                                           [&](const aerie::spherical_depth_t&, const bus::ReceiveInfo&) { ++depth_msgs; });
-  stereo::VoNodeConfig cfg;
-  cfg.vo.ba.enabled = false;
+  const stereo::VoNodeConfig cfg = without_ba();
   stereo::VoNode node(bus, status, cfg);
 
-  const sim::World world = sim::World::room(sim::WorldConfig{});
-  sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+  Survey survey;
+  sim::StereoSimulation& simulation = survey.simulation;
   const auto K = simulation.intrinsics();
   sim::StereoFrame f;
   for (int i = 0; i < 6 && simulation.next(f); ++i) {
@@ -122,11 +135,10 @@ TEST(VoNode, OneCorruptPairDoesNotRestartTheOdometryAPersistentNewCameraDoes) {
   // "positive" check and restarted the odometry twice, and the flight lost its frame.
   bus::Bus bus("memq://");
   bus::StatusReporter status(bus, "VO");
-  stereo::VoNodeConfig cfg;
-  cfg.vo.ba.enabled = false;
+  const stereo::VoNodeConfig cfg = without_ba();
   stereo::VoNode node(bus, status, cfg);
-  const sim::World world = sim::World::room(sim::WorldConfig{});
-  sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+  Survey survey;
+  sim::StereoSimulation& simulation = survey.simulation;
   const auto K = simulation.intrinsics();
   sim::StereoFrame f;
   auto next = [&] {
@@ -172,11 +184,10 @@ TEST(VoNode, OddImageSizesGiveDepthOnEveryDepthFrame) {
     int depth_msgs = 0;
     bus.subscribe<aerie::spherical_depth_t>("VO_DEPTH",
                                             [&](const aerie::spherical_depth_t&, const bus::ReceiveInfo&) { ++depth_msgs; });
-    stereo::VoNodeConfig cfg;
-    cfg.vo.ba.enabled = false;
+    const stereo::VoNodeConfig cfg = without_ba();
     stereo::VoNode node(bus, status, cfg);
-    const sim::World world = sim::World::room(sim::WorldConfig{});
-    sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+    Survey survey;
+  sim::StereoSimulation& simulation = survey.simulation;
     const auto K = simulation.intrinsics();
     sim::StereoFrame f;
     for (int i = 0; i < 6 && simulation.next(f); ++i) {
@@ -204,12 +215,11 @@ TEST(VoNode, A25SecondCameraOutageIsReportedAndTheOdometryRecovers) {
   bus::StatusReporter status(bus, "VO");
   std::vector<aerie::pose_t> poses;
   bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t& p, const bus::ReceiveInfo&) { poses.push_back(p); });
-  stereo::VoNodeConfig cfg;
-  cfg.vo.ba.enabled = false;
+  const stereo::VoNodeConfig cfg = without_ba();
   int64_t now = 1'000'000'000;
   stereo::VoNode node(bus, status, cfg, [&] { return now; });
-  const sim::World world = sim::World::room(sim::WorldConfig{});
-  sim::StereoSimulation simulation(world, sim::RigConfig{}, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0);
+  Survey survey;
+  sim::StereoSimulation& simulation = survey.simulation;
   const auto K = simulation.intrinsics();
   sim::StereoFrame f;
   auto pair = [&](int64_t shift_us) {
