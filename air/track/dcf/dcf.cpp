@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "air/track/dcf/fhog.hpp"
+#include "air/track/dcf/window.hpp"
 
 namespace aerie::track {
 namespace {
@@ -16,37 +17,8 @@ void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("dcf: " + what);
 }
 
-// The window of `size` image pixels centred on `centre` (a pixel of the image), replicated
-// beyond the image border, resized to `out`.
-cv::Mat subwindow(const cv::Mat& image, cv::Point2d centre, cv::Size2d size, cv::Size out) {
-  const cv::Rect r(cvFloor(centre.x - size.width / 2), cvFloor(centre.y - size.height / 2),
-                   std::max(1, cvRound(size.width)), std::max(1, cvRound(size.height)));
-  const cv::Rect inside = r & cv::Rect(0, 0, image.cols, image.rows);
-  cv::Mat patch;
-  if (inside == r) {
-    patch = image(r);
-  } else {
-    cv::copyMakeBorder(image(inside), patch, inside.y - r.y, r.br().y - inside.br().y, inside.x - r.x,
-                       r.br().x - inside.br().x, cv::BORDER_REPLICATE);
-  }
-  cv::Mat resized;
-  cv::resize(patch, resized, out, 0, 0, out.area() < patch.size().area() ? cv::INTER_AREA : cv::INTER_LINEAR);
-  return resized;
-}
-
-// Symmetric Hann window of n samples.
-std::vector<float> hann(int n) {
-  std::vector<float> w(n, 1.f);
-  if (n > 1)
-    for (int i = 0; i < n; ++i) w[i] = 0.5f * (1 - std::cos(2 * CV_PI * i / (n - 1)));
-  return w;
-}
-
 Complex* cptr(cv::Mat& m) { return m.ptr<Complex>(); }
 const Complex* cptr(const cv::Mat& m) { return m.ptr<Complex>(); }
-
-// Signed circular offset of index i on a grid of n.
-int circular(int i, int n) { return i > n / 2 ? i - n : i; }
 
 // Parabolic sub-cell refinement of a peak from its two circular neighbours.
 double refine(float left, float centre, float right) {
@@ -107,63 +79,14 @@ void DcfParams::validate() const {
 }
 
 cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask, const DcfParams& p) {
-  const size_t n = xf.total();
-  const float lambda = static_cast<float>(p.lambda);
   cv::Mat yx(xf.size(), CV_32FC2), sxx(xf.size(), CV_32F);
   const Complex* x = cptr(xf);
   const Complex* y = cptr(yf);
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < xf.total(); ++k) {
     cptr(yx)[k] = y[k] * std::conj(x[k]);
     sxx.ptr<float>()[k] = std::norm(x[k]);
   }
-  auto project = [&](const cv::Mat& spectrum, float divisor) {  // m . IDFT(.) / divisor, back to DFT
-    cv::Mat g, gf;
-    cv::dft(spectrum, g, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-    cv::dft(g.mul(mask) / divisor, gf, cv::DFT_COMPLEX_OUTPUT);
-    return gf;
-  };
-  cv::Mat g(xf.size(), CV_32FC2), l(xf.size(), CV_32FC2, cv::Scalar::all(0));
-  for (size_t k = 0; k < n; ++k) cptr(g)[k] = cptr(yx)[k] / (sxx.ptr<float>()[k] + lambda);
-  cv::Mat gm = project(g, 1.f);
-  float mu = static_cast<float>(p.admm_mu);
-  const float d = static_cast<float>(n);
-  for (int it = 0; it < p.admm_iterations; ++it) {
-    for (size_t k = 0; k < n; ++k)
-      cptr(g)[k] = (cptr(yx)[k] + mu * cptr(gm)[k] - cptr(l)[k]) / (sxx.ptr<float>()[k] + mu);
-    gm = project(l + mu * g, lambda / (2 * d) + mu);
-    l += mu * (g - gm);
-    mu = std::min(mu * static_cast<float>(p.admm_beta), static_cast<float>(p.admm_mu_max));
-  }
-  return gm;
-}
-
-void LinearFilter::learn(const cv::Mat& xf, const cv::Mat& yf, double rate) {
-  cv::Mat num(xf.size(), CV_32FC2), den = cv::Mat::zeros(1, xf.cols, CV_32F);
-  const Complex* y = cptr(yf);
-  float* d = den.ptr<float>();
-  for (int r = 0; r < xf.rows; ++r) {
-    const Complex* x = xf.ptr<Complex>(r);
-    Complex* n = num.ptr<Complex>(r);
-    for (int k = 0; k < xf.cols; ++k) {
-      n[k] = std::conj(y[k]) * x[k];
-      d[k] += std::norm(x[k]);
-    }
-  }
-  blend(num_, num, rate);
-  blend(den_, den, rate);
-}
-
-cv::Mat LinearFilter::respond(const cv::Mat& zf, double lambda) const {
-  cv::Mat out(1, zf.cols, CV_32FC2, cv::Scalar::all(0));
-  Complex* o = cptr(out);
-  for (int r = 0; r < zf.rows; ++r) {
-    const Complex* z = zf.ptr<Complex>(r);
-    const Complex* a = num_.ptr<Complex>(r);
-    for (int k = 0; k < zf.cols; ++k) o[k] += std::conj(a[k]) * z[k];
-  }
-  const float* b = den_.ptr<float>();
-  for (int k = 0; k < zf.cols; ++k) o[k] /= b[k] + static_cast<float>(lambda);
-  return out;
+  return masked_filter(yx, sxx, mask, p.admm());
 }
 
 namespace {
@@ -190,24 +113,6 @@ DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& patch) cons
   Spectrum xf(channels.size());
   for (size_t c = 0; c < channels.size(); ++c) cv::dft(channels[c].mul(hann_), xf[c], cv::DFT_COMPLEX_OUTPUT);
   return xf;
-}
-
-cv::Mat DcfTracker::scale_features(const cv::Mat& frame) const {
-  cv::Mat xs;  // feature dimension x scales
-  for (int i = 0; i < p_.scales; ++i) {
-    const cv::Mat patch = subwindow(frame, pos_, target_ * (scale_ * scale_factors_[i]), scale_model_);
-    const std::vector<cv::Mat> h = fhog(patch, p_.cell);
-    const int cells = static_cast<int>(h[0].total());
-    if (xs.empty()) xs.create(cells * static_cast<int>(h.size()), p_.scales, CV_32F);
-    const float w = scale_hann_.at<float>(i);
-    for (size_t c = 0; c < h.size(); ++c) {
-      const float* src = h[c].ptr<float>();
-      for (int k = 0; k < cells; ++k) xs.at<float>(static_cast<int>(c) * cells + k, i) = w * src[k];
-    }
-  }
-  cv::Mat xsf;
-  cv::dft(xs, xsf, cv::DFT_ROWS | cv::DFT_COMPLEX_OUTPUT);
-  return xsf;
 }
 
 // Staple's per-pixel likelihood P(foreground | colour) = H_fg / (H_fg + H_bg).
@@ -266,7 +171,7 @@ void DcfTracker::learn_colour(const cv::Mat& patch, double rate) {
 void DcfTracker::learn(const cv::Mat& frame, bool first) {
   const cv::Mat patch = window_patch(frame, pos_);
   learn_translation(translation_features(patch), first ? 1.0 : p_.learning_rate);
-  scale_filter_.learn(scale_features(frame), ysf_, first ? 1.0 : p_.scale_learning_rate);
+  scale_filter_.learn(frame, pos_, scale_, first ? 1.0 : p_.scale_learning_rate);
   if (p_.hist_weight > 0) learn_colour(patch, first ? 1.0 : p_.hist_learning_rate);
 }
 
@@ -318,35 +223,10 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
     }
   cv::dft(y, yf_, cv::DFT_COMPLEX_OUTPUT);
 
-  // Scale filter (DSST): S samples at step^(S/2 - i) of the current size, each resized to
-  // scale_model_area pixels of the target's aspect ratio.
-  scale_factors_.resize(p_.scales);
-  for (int i = 0; i < p_.scales; ++i) scale_factors_[i] = std::pow(p_.scale_step, p_.scales / 2 - i);
-  const double rs = std::sqrt(p_.scale_model_area / target_.area());
-  scale_model_ = {std::max(2 * p_.cell, cvRound(target_.width * rs)),
-                  std::max(2 * p_.cell, cvRound(target_.height * rs))};
-  const std::vector<float> w = hann(p_.scales);
-  scale_hann_ = cv::Mat(w, true).reshape(1, 1);
-  const double ssigma = p_.scale_sigma * std::sqrt(static_cast<double>(p_.scales));
-  cv::Mat ys(1, p_.scales, CV_32F);
-  for (int i = 0; i < p_.scales; ++i) {
-    const double d = i - p_.scales / 2;
-    ys.at<float>(i) = static_cast<float>(std::exp(-0.5 * d * d / (ssigma * ssigma)));
-  }
-  cv::dft(ys, ysf_, cv::DFT_ROWS | cv::DFT_COMPLEX_OUTPUT);
+  scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
 
   learn(frame, true);
   initialised_ = true;
-}
-
-// Scale: the best of the S scale samples at the current location (DSST).
-double DcfTracker::best_scale_change(const cv::Mat& frame) const {
-  cv::Mat sresponse;
-  cv::dft(scale_filter_.respond(scale_features(frame), p_.scale_lambda), sresponse,
-          cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE | cv::DFT_ROWS);
-  cv::Point best;
-  cv::minMaxLoc(sresponse, nullptr, nullptr, nullptr, &best);
-  return scale_factors_[best.x];
 }
 
 DcfTracker::Detection DcfTracker::detect(const cv::Mat& frame, cv::Point2d centre) const {
@@ -458,7 +338,7 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   const cv::Point2d at = peak_location(d);
   pos_.x = std::clamp(at.x, 0.0, frame.cols - 1.0);
   pos_.y = std::clamp(at.y, 0.0, frame.rows - 1.0);
-  scale_ = std::clamp(scale_ * best_scale_change(frame), p_.min_scale, p_.max_scale);
+  scale_ = std::clamp(scale_ * scale_filter_.best_change(frame, pos_, scale_), p_.min_scale, p_.max_scale);
   if (confident) learn(frame, false);
 
   TrackState s;

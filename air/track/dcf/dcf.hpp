@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "air/track/dcf/filters.hpp"
+#include "air/track/dcf/scale_filter.hpp"
 #include "air/track/tracker.hpp"
 
 namespace aerie::track {
@@ -64,6 +66,10 @@ struct DcfParams {
   double found_confidence = 0.7;
 
   void validate() const;  // throws std::invalid_argument naming the bad value
+  AdmmSettings admm() const { return {lambda, admm_iterations, admm_mu, admm_beta, admm_mu_max}; }
+  ScaleFilterParams scale_filter() const {
+    return {scales, scale_step, scale_sigma, scale_lambda, scale_model_area, cell};
+  }
 };
 
 // CSR-DCF's constrained filter of one channel (Lukezic et al. 2017, eqs. 6-8): the G
@@ -72,17 +78,6 @@ struct DcfParams {
 // admm_mu growing by admm_beta per step up to admm_mu_max). xf, yf: CV_32FC2 full DFTs of the
 // (windowed) feature channel and the label; mask: CV_32F of 0/1, same size.
 cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask, const DcfParams& p);
-
-// A multi-channel linear correlation filter (Danelljan et al. 2014, eqs. 4-5) on spectra
-// stacked one feature channel per row (CV_32FC2): running numerator A = conj(Y) X per row and
-// denominator B = sum over rows of |X|^2; response spectrum sum over rows of conj(A) Z / (B + lambda).
-class LinearFilter {
- public:
-  void learn(const cv::Mat& xf, const cv::Mat& yf, double rate);  // yf: one row
-  cv::Mat respond(const cv::Mat& zf, double lambda) const;         // one row
- private:
-  cv::Mat num_, den_;
-};
 
 class DcfTracker : public Tracker {
  public:
@@ -103,9 +98,7 @@ class DcfTracker : public Tracker {
   cv::Point2d peak_location(const Detection& d) const;
   cv::Mat window_patch(const cv::Mat& frame, cv::Point2d centre) const;  // at scale_, resized
   Spectrum translation_features(const cv::Mat& patch) const;
-  cv::Mat scale_features(const cv::Mat& frame) const;  // DFT along the scales of the S samples at pos_
   cv::Mat colour_likelihood(const cv::Mat& patch) const;
-  double best_scale_change(const cv::Mat& frame) const;
   void learn_translation(const Spectrum& xf, double rate);
   void learn_colour(const cv::Mat& patch, double rate);
   void learn(const cv::Mat& frame, bool first);
@@ -126,11 +119,7 @@ class DcfTracker : public Tracker {
   Spectrum filter_;      // spatial_mask: G_c per channel, running
   cv::Mat mask_;         // cells, 1 inside the target box
 
-  cv::Size scale_model_;
-  std::vector<double> scale_factors_;
-  cv::Mat scale_hann_;   // 1 x S
-  cv::Mat ysf_;
-  LinearFilter scale_filter_;
+  ScaleFilter scale_filter_;
 
   cv::Mat fg_hist_, bg_hist_;  // colour histograms, normalised
   double mean_peak_ = 0, mean_apce_ = 0;
