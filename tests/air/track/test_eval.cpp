@@ -1,10 +1,12 @@
-// OTB one-pass metrics, the sequence reader, the attributes and the LOST-flag score.
+// OTB one-pass metrics, the sequence reader, the attributes, the LOST-flag score and the k-fold protocol.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 
 #include "air/track/eval/attributes.hpp"
+#include "air/track/eval/folds.hpp"
+#include "air/track/eval/grid.hpp"
 #include "air/track/eval/lost.hpp"
 #include "air/track/eval/metrics.hpp"
 #include "air/track/eval/sequence.hpp"
@@ -207,4 +209,82 @@ TEST(Attributes, SharedSequencesMatchTheirSourceTxtStatistics) {
   EXPECT_TRUE(g.occlusion);  // from the OTB tags only: Girl has no absent frame
   EXPECT_EQ(g.absent, 0);
   EXPECT_FALSE(g.fast_motion || g.low_resolution || g.scale_variation);  // 12 px, 620 px, (0.67, 1.28)
+}
+
+TEST(Folds, AssignmentBySortedNameModuloK) {
+  const std::vector<std::string> names = {"b", "a", "d", "c", "e"};  // sorted: a b c d e
+  EXPECT_EQ(assign_folds(names, 2), (std::vector<int>{1, 0, 1, 0, 0}));
+  EXPECT_EQ(assign_folds(names, 5), (std::vector<int>{1, 0, 3, 2, 4}));  // leave one sequence out
+  EXPECT_EQ(assign_folds({"Skiing", "uav123", "Girl"}, 3), (std::vector<int>{1, 2, 0}));  // byte order
+  aerie::test::expect_refusals([&](const std::string& k) { assign_folds(names, std::stoi(k)); },
+                               {{"1", "1 folds for 5 sequences"}, {"6", "need 2 <= folds <= sequences"},
+                                {"0", "need 2 <= folds"}});
+}
+
+TEST(Folds, TunedOnAndHeldOutByHand) {
+  // AUC (= P20 here) of 3 candidates on 4 sequences; CLE = 10 c + s. Folds: s0, s2 -> 0; s1, s3 -> 1.
+  // Candidates 1 and 2 are each good on one fold only: tuning on one fold picks the one that fails
+  // on the other, so held out they score 0.1 where the tuned-on figure says 0.85.
+  const std::vector<double> auc[3] = {{0.5, 0.5, 0.5, 0.5}, {0.9, 0.1, 0.9, 0.1}, {0.1, 0.8, 0.1, 0.8}};
+  std::vector<std::vector<Figures>> scores(3);
+  for (int c = 0; c < 3; ++c)
+    for (int s = 0; s < 4; ++s) scores[c].push_back({auc[c][s], auc[c][s], 10.0 * c + s});
+  const std::vector<int> fold = {0, 1, 0, 1};
+  const auto r = cross_validate(scores, fold);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[0].candidate, 2);  // tuned on s1, s3: 0.5, 0.1, 0.8
+  EXPECT_EQ(r[0].tuned, (std::vector<size_t>{1, 3}));
+  EXPECT_EQ(r[0].heldout, (std::vector<size_t>{0, 2}));
+  EXPECT_DOUBLE_EQ(r[0].tuned_figures.auc, 0.8);
+  EXPECT_DOUBLE_EQ(r[0].tuned_figures.mean_centre_error, 22);  // (21 + 23) / 2
+  EXPECT_DOUBLE_EQ(r[0].heldout_figures.auc, 0.1);
+  EXPECT_DOUBLE_EQ(r[0].heldout_figures.precision20, 0.1);
+  EXPECT_DOUBLE_EQ(r[0].heldout_figures.mean_centre_error, 21);  // (20 + 22) / 2
+  EXPECT_EQ(r[1].candidate, 1);  // tuned on s0, s2: 0.5, 0.9, 0.1
+  EXPECT_DOUBLE_EQ(r[1].tuned_figures.auc, 0.9);
+  EXPECT_DOUBLE_EQ(r[1].heldout_figures.mean_centre_error, 12);  // (11 + 13) / 2
+  const HeldOutSummary h = summarise(r, scores);
+  EXPECT_EQ(h.sequences, 4);
+  EXPECT_DOUBLE_EQ(h.tuned.auc, 0.85);
+  EXPECT_DOUBLE_EQ(h.heldout.auc, 0.1);
+  EXPECT_DOUBLE_EQ(h.tuned.mean_centre_error, 16.5);
+  EXPECT_DOUBLE_EQ(h.heldout.mean_centre_error, 16.5);  // (20 + 11 + 22 + 13) / 4
+
+  // Ties go to the lower index; a single candidate is always chosen.
+  std::vector<std::vector<Figures>> tie = {scores[0], scores[0]};
+  for (const auto& f : cross_validate(tie, fold)) EXPECT_EQ(f.candidate, 0);
+  EXPECT_EQ(cross_validate({scores[1]}, fold)[0].candidate, 0);
+  EXPECT_THROW(cross_validate(scores, {0, 1, 0}), std::invalid_argument);    // 4 scores, 3 sequences
+  EXPECT_THROW(cross_validate(scores, {0, 0, 0, 0}), std::invalid_argument);  // nothing to tune on
+}
+
+TEST(Folds, GridMergesCandidatesOverTheBaseSettings) {
+  const auto base = aerie::util::Config::parse("dcf:\n  lambda: 0.02\n  learning_rate: 0.01\n", "track.yaml");
+  const auto grid = aerie::util::Config::parse("dcf:\n  - {}\n  - {learning_rate: 0.05}\n", "grid.yaml");
+  const auto c = load_grid(grid, base, {"dcf", "opencv-kcf"});
+  ASSERT_EQ(c.size(), 2u);
+  ASSERT_EQ(c[0].size(), 2u);
+  EXPECT_EQ(c[0][0].settings, "{}");
+  EXPECT_DOUBLE_EQ(c[0][0].params.get<double>("learning_rate", 0), 0.01);
+  EXPECT_EQ(c[0][1].settings, "{learning_rate: 0.05}");
+  EXPECT_DOUBLE_EQ(c[0][1].params.get<double>("learning_rate", 0), 0.05);
+  EXPECT_DOUBLE_EQ(c[0][1].params.get<double>("lambda", 0), 0.02);  // kept from the base
+  ASSERT_EQ(c[1].size(), 1u);  // not in the grid: its base settings
+  EXPECT_EQ(c[1][0].settings, "{}");
+  EXPECT_EQ(load_grid({}, base, {"dcf"})[0].size(), 1u);  // no grid at all
+}
+
+TEST(Folds, BadGridsAreRefusedNamingTheProblem) {
+  const std::vector<std::string> trackers = {"dcf", "opencv-kcf"};
+  aerie::test::expect_refusals(
+      [&](const std::string& text) { load_grid(aerie::util::Config::parse(text, "grid.yaml"), {}, trackers); },
+      {{"nosuch:\n  - {}\n", "grid.yaml: unknown tracker 'nosuch'"},
+       {"opencv-csrt:\n  - {}\n", "tracker 'opencv-csrt' is not among the trackers run"},
+       {"dcf:\n  - {nosuch: 1}\n", "grid.yaml:dcf[0]: unknown parameter 'nosuch' for tracker 'dcf'"},
+       {"dcf:\n  - {}\n  - {cell: 100}\n", "grid.yaml:dcf[1]: key 'cell' = 100 is outside its valid range"},
+       {"opencv-kcf:\n  - {padding: 2}\n", "unknown parameter 'padding' for tracker 'opencv-kcf'"},
+       {"dcf: {lambda: 0.01}\n", "grid.yaml:dcf: expected a non-empty list"},
+       {"dcf: []\n", "grid.yaml:dcf: expected a non-empty list"},
+       {"dcf:\n  - 3\n", "grid.yaml:dcf[0]: a candidate is a map of parameters"},
+       {"- dcf\n", "grid.yaml: expected a map of tracker name"}});
 }
