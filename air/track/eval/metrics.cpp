@@ -61,4 +61,18 @@ Score score(const std::vector<cv::Rect2d>& predicted, const std::vector<cv::Rect
   return s;
 }
 
+Figures figures(const Score& s) { return {s.auc, s.precision20, s.mean_centre_error}; }
+
+Figures mean(const std::vector<Figures>& per_sequence) {
+  if (per_sequence.empty()) return {NAN, NAN, NAN};
+  Figures m;
+  for (const auto& f : per_sequence) {
+    m.auc += f.auc;
+    m.precision20 += f.precision20;
+    m.mean_centre_error += f.mean_centre_error;
+  }
+  const double n = static_cast<double>(per_sequence.size());
+  return {m.auc / n, m.precision20 / n, m.mean_centre_error / n};
+}
+
 }  // namespace aerie::track::eval

@@ -25,4 +25,12 @@ struct Score {
 // predicted[i] is the box for ground truth groundtruth[i]; sizes must match.
 Score score(const std::vector<cv::Rect2d>& predicted, const std::vector<cv::Rect2d>& groundtruth);
 
+// The three figures the tables report for a sequence (AUC, P@20, CLE) and their mean over sequences.
+struct Figures {
+  double auc = 0, precision20 = 0, mean_centre_error = 0;
+};
+Figures figures(const Score& s);
+// NaN figures for an empty list.
+Figures mean(const std::vector<Figures>& per_sequence);
+
 }  // namespace aerie::track::eval
