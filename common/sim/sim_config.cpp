@@ -63,6 +63,27 @@ IntruderConfig load_intruder_config(const util::Config& c) {
   return i;
 }
 
+ExitsConfig load_exits_config(const util::Config& config) {
+  config.check_keys({"exits.*"});
+  const util::Config c = config.section("exits");
+  ExitsConfig e;
+  using E = ExitsConfig;
+  SectionReader<E>(c, e)("seed", &E::seed)("width", &E::width)("height", &E::height)("rate_hz", &E::rate_hz)(
+      "start_utime", &E::start_utime)("vibration_px", &E::vibration_px)("wingspan_px", &E::wingspan_px)(
+      "scale_amplitude", &E::scale_amplitude)("max_roll_deg", &E::max_roll_deg)("noise_sigma", &E::noise_sigma)(
+      "color", &E::color)("exits", &E::exits)("kinds", &E::kinds)("in_frames_min", &E::in_frames_min)(
+      "in_frames_max", &E::in_frames_max)("out_frames_min", &E::out_frames_min)(
+      "out_frames_max", &E::out_frames_max)("min_visible", &E::min_visible)("pan_speed_px", &E::pan_speed_px)(
+      "drift_speed_px", &E::drift_speed_px)("reenter_elsewhere", &E::reenter_elsewhere)
+      .finish();
+  try {
+    validate_exits_config(e);
+  } catch (const std::invalid_argument& x) {
+    throw std::runtime_error(c.origin() + ": " + x.what());
+  }
+  return e;
+}
+
 SimulationConfig load_simulation_config(const util::Config& c) {
   const YAML::Node& root = c.node();
   if (root && root.IsMap())
