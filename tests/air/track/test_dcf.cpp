@@ -104,6 +104,7 @@ TEST(Fhog, MatchesTheScalarReference) {
 
 TEST(Fhog, BadInputIsRejected) {
   EXPECT_THROW(fhog(cv::Mat(), 4), std::invalid_argument);
+  EXPECT_THROW(fhog(cv::Mat(10, 10, CV_32F), 4), std::invalid_argument);
   EXPECT_THROW(fhog(cv::Mat(10, 10, CV_8U), 0), std::invalid_argument);
   EXPECT_THROW(fhog(cv::Mat(3, 10, CV_8U), 4), std::invalid_argument);
 }
