@@ -205,9 +205,9 @@ void export_intruder(const sim::IntruderScene& scene, const fs::path& out, const
 // with less than min_visible of the box in view is NaN,NaN,NaN,NaN.
 void export_exits(sim::ExitsConfig cfg, const fs::path& out, const std::string& name, int count,
                   const std::string& ext) {
-  const uint64_t seed = cfg.seed;
+  const uint64_t seed = cfg.look.seed;
   for (int i = 1; i <= count; ++i) {
-    cfg.seed = seed + static_cast<uint64_t>(i - 1);
+    cfg.look.seed = seed + static_cast<uint64_t>(i - 1);
     const sim::ExitsScene scene(cfg);
     char dir[256];
     std::snprintf(dir, sizeof dir, "%s_%02d", name.c_str(), i);
@@ -222,7 +222,7 @@ void export_exits(sim::ExitsConfig cfg, const fs::path& out, const std::string& 
                  return OtbFrame{std::move(f.mono.image), f.mono.target_box, f.in_view,
                                  mono_row(k + 1, f.mono, f.in_view ? 1 : 0) + tail};
                });
-    spdlog::info("wrote {} frames ({} out of view, seed {}) to {}", scene.frame_count(), out_of_view, cfg.seed,
+    spdlog::info("wrote {} frames ({} out of view, seed {}) to {}", scene.frame_count(), out_of_view, cfg.look.seed,
                  (out / dir).string());
   }
 }

@@ -31,9 +31,10 @@ void validate_exits_config(const ExitsConfig& c) {
   auto check = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("sim::ExitsConfig: " + what);
   };
-  check(c.width >= 64 && c.height >= 64, "width and height must be >= 64");
-  check(c.rate_hz > 0, "rate_hz must be > 0");
-  check(c.wingspan_px >= 8 && c.wingspan_px * (1 + c.scale_amplitude) <= 0.25 * std::min(c.width, c.height),
+  const IntruderConfig& l = c.look;
+  check(l.width >= 64 && l.height >= 64, "width and height must be >= 64");
+  check(l.rate_hz > 0, "rate_hz must be > 0");
+  check(l.wingspan_px >= 8 && l.wingspan_px * (1 + c.scale_amplitude) <= 0.25 * std::min(l.width, l.height),
         "wingspan_px * (1 + scale_amplitude) must be in [8, 0.25 min(width, height)]");
   check(c.scale_amplitude >= 0 && c.scale_amplitude < 0.5, "scale_amplitude must be in [0, 0.5)");
   check(c.exits >= 0, "exits must be >= 0");
@@ -70,26 +71,12 @@ ExitsScene::ExitsScene(const ExitsConfig& c, Plan plan)
       mast_x_(std::move(plan.mast_x)),
       event_(std::move(plan.event)),
       mast_width_(plan.mast_width),
-      scene_(
-          [&] {
-            IntruderConfig i;
-            i.seed = c.seed;
-            i.width = c.width;
-            i.height = c.height;
-            i.rate_hz = c.rate_hz;
-            i.start_utime = c.start_utime;
-            i.vibration_px = c.vibration_px;
-            i.wingspan_px = c.wingspan_px;
-            i.max_roll_deg = c.max_roll_deg;
-            i.noise_sigma = c.noise_sigma;
-            i.color = c.color;
-            return i;
-          }(),
-          path_) {
+      scene_(c.look, path_) {
   // The mast: dark value noise (a tower close to the camera).
-  const cv::Mat n = value_noise(cv::Size(cvCeil(mast_width_) + 2, c.height), 12, 4, 0.6, mix_seed(c.seed, 21));
+  const cv::Mat n =
+      value_noise(cv::Size(cvCeil(mast_width_) + 2, c.look.height), 12, 4, 0.6, mix_seed(c.look.seed, 21));
   n.convertTo(mast_, CV_8U, 70, 25);
-  if (c.color) cv::cvtColor(mast_, mast_, cv::COLOR_GRAY2BGR);
+  if (c.look.color) cv::cvtColor(mast_, mast_, cv::COLOR_GRAY2BGR);
   const ExitsFrame first = frame(0);
   if (first.visible_fraction < 1.0)
     throw std::logic_error("sim::ExitsScene: the aircraft is not fully in view at the first frame");
@@ -97,16 +84,16 @@ ExitsScene::ExitsScene(const ExitsConfig& c, Plan plan)
 
 ExitsScene::ExitsScene(const ExitsConfig& c) : ExitsScene(c, [&] {
   validate_exits_config(c);
-  cv::RNG rng(mix_seed(c.seed, 20));
-  const double W = c.width, H = c.height;
-  const double r = 0.52 * c.wingspan_px * (1 + c.scale_amplitude);  // the silhouette's bounding circle
-  const double margin = 4 + 8 * c.vibration_px;
+  cv::RNG rng(mix_seed(c.look.seed, 20));
+  const double W = c.look.width, H = c.look.height;
+  const double r = 0.52 * c.look.wingspan_px * (1 + c.scale_amplitude);  // the silhouette's bounding circle
+  const double margin = 4 + 8 * c.look.vibration_px;
   const double phase_scale = rng.uniform(0.0, 2 * CV_PI), phase_roll = rng.uniform(0.0, 2 * CV_PI);
   const double heading = rng.uniform(0, 2) ? 0.0 : CV_PI;  // nose right or left
   const int first_kind = c.kinds.empty() ? 0 : rng.uniform(0, static_cast<int>(c.kinds.size()));
 
   Plan p;
-  p.mast_width = 2 * (r + 1) + 0.2 * c.wingspan_px;
+  p.mast_width = 2 * (r + 1) + 0.2 * c.look.wingspan_px;
   cv::Point2d q(0.5 * W, 0.5 * H), pan(0, 0);  // where the aircraft is seen, the camera's pan
   double mast = kNaN;
   int event = -1;
@@ -116,7 +103,7 @@ ExitsScene::ExitsScene(const ExitsConfig& c) : ExitsScene(c, [&] {
     pose.pan = pan;
     pose.center = q + pan;
     pose.scale = 1 + c.scale_amplitude * std::sin(2 * CV_PI * k / 240 + phase_scale);
-    pose.angle = heading + c.max_roll_deg * CV_PI / 180 * std::sin(2 * CV_PI * k / 100 + phase_roll);
+    pose.angle = heading + c.look.max_roll_deg * CV_PI / 180 * std::sin(2 * CV_PI * k / 100 + phase_roll);
     p.path.push_back(pose);
     p.mast_x.push_back(mast);
     p.event.push_back(event);
@@ -149,7 +136,7 @@ ExitsScene::ExitsScene(const ExitsConfig& c) : ExitsScene(c, [&] {
       // Occlusion, horizontal. The mast and the aircraft vibrate together, so only the
       // silhouette's circle (plus 1 px) matters: the aircraft waits where its crossing will be
       // centred in the image, the mast slides in from the border ahead and stops `gap` ahead of it.
-      const double rc = r + 1, gap = 0.1 * c.wingspan_px, travel = 4 * rc + 4 * gap;
+      const double rc = r + 1, gap = 0.1 * c.look.wingspan_px, travel = 4 * rc + 4 * gap;
       to.x = dir > 0 ? 0.5 * (W - travel) : W - 0.5 * (W - travel);
       wander(to, in_frames());
       event = kind;
@@ -217,17 +204,15 @@ ExitsFrame ExitsScene::frame(int k) const {
   f.mono = scene_.frame(k);
   const IntruderPose& pose = path_[k];
   const cv::Point2d jitter = f.mono.target_center - (pose.center - pose.pan);
+  const int w = config_.look.width, h = config_.look.height;
   if (!std::isnan(mast_x_[k])) {
     const double x0 = mast_x_[k] + jitter.x;
-    f.occluder = cv::Rect2d(x0, 0, mast_width_, config_.height);
+    f.occluder = cv::Rect2d(x0, 0, mast_width_, h);
     // Pixels whose centres lie within the mast.
-    const int c0 = std::max(0, cvCeil(x0)), c1 = std::min(config_.width, cvCeil(x0 + mast_width_));
-    if (c1 > c0) {
-      const int t0 = c0 - cvCeil(x0);
-      mast_(cv::Rect(t0, 0, c1 - c0, config_.height)).copyTo(f.mono.image(cv::Rect(c0, 0, c1 - c0, config_.height)));
-    }
+    const int c0 = std::max(0, cvCeil(x0)), c1 = std::min(w, cvCeil(x0 + mast_width_));
+    if (c1 > c0) mast_(cv::Rect(c0 - cvCeil(x0), 0, c1 - c0, h)).copyTo(f.mono.image(cv::Rect(c0, 0, c1 - c0, h)));
   }
-  f.visible_fraction = visible_fraction(f.mono.target_box, cv::Size(config_.width, config_.height), f.occluder);
+  f.visible_fraction = visible_fraction(f.mono.target_box, cv::Size(w, h), f.occluder);
   f.in_view = f.visible_fraction >= config_.min_visible;
   if (event_[k] >= 0) f.event = kKinds[event_[k]];
   return f;

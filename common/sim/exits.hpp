@@ -20,16 +20,16 @@
 namespace aerie::sim {
 
 struct ExitsConfig {
-  uint64_t seed = 1;
-  int width = 640, height = 480;
-  double rate_hz = 20.0;
-  int64_t start_utime = 0;
-  double vibration_px = 1.0;       // as IntruderConfig
-  double wingspan_px = 80.0;       // apparent wingspan at scale 1 (px)
-  double scale_amplitude = 0.15;   // the apparent size varies by +- this fraction
-  double max_roll_deg = 10.0;
-  double noise_sigma = 1.5;
-  bool color = false;
+  // Sky, aircraft, camera and image as the intruder scene's (its frames, scale_change and
+  // draw_target are not used), with a steadier camera and a smaller aircraft by default.
+  IntruderConfig look = [] {
+    IntruderConfig i;
+    i.vibration_px = 1.0;
+    i.wingspan_px = 80.0;  // apparent wingspan at scale 1 (px)
+    i.max_roll_deg = 10.0;
+    return i;
+  }();
+  double scale_amplitude = 0.15;  // the apparent size varies by +- this fraction
   int exits = 3;                                          // exits per sequence
   std::vector<std::string> kinds = {"pan", "drift", "occlusion"};  // taken in turn from a seeded one
   int in_frames_min = 20, in_frames_max = 50;   // in-view wandering before each exit and after the last
