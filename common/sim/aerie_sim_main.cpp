@@ -3,6 +3,7 @@
 //   aerie-sim stereo    [--config F] --out DIR    KITTI-odometry-style stereo folder + depth
 //   aerie-sim landing   [--config F] --out DIR    helipad-landing tracking sequence (OTB-style)
 //   aerie-sim intruder  [--config F] --out DIR    intruder-aircraft tracking sequence (OTB-style)
+//   aerie-sim exits     [--config F] --out DIR    sequences where the target leaves the image and returns
 #include <CLI/CLI.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
@@ -150,25 +151,80 @@ void export_landing(sim::StereoSimulation& s, const fs::path& out, const std::st
                last, out.string());
 }
 
-void export_intruder(sim::IntruderScene& scene, const fs::path& out, const std::string& ext) {
+// One frame of an OTB-style folder: the image, the box of groundtruth.txt (written
+// NaN,NaN,NaN,NaN when the target is out of view) and the row of groundtruth_full.csv.
+struct OtbFrame {
+  cv::Mat image;
+  cv::Rect2d box;
+  bool in_view = true;
+  std::string full;
+};
+
+// img/0001.<ext>..., groundtruth.txt, groundtruth_full.csv (`header` + one row a frame).
+template <typename FrameFn>
+int export_otb(const fs::path& out, const std::string& ext, int frames, const std::string& header, FrameFn frame) {
   fs::create_directories(out / "img");
   auto gt = open_out(out / "groundtruth.txt"), full = open_out(out / "groundtruth_full.csv");
-  full << "frame,utime,visible,x,y,w,h,center_x,center_y,scale,angle_rad\n";
-  char name[64], line[512];
-  sim::MonoFrame f;
-  int n = 0;
-  while (scene.next(f)) {
-    ++n;
-    write_image(out / "img" / frame_name(name, sizeof name, ("%04d." + ext).c_str(), n), f.image);
-    const auto& b = f.target_box;
-    std::snprintf(line, sizeof line, "%.3f,%.3f,%.3f,%.3f\n", b.x, b.y, b.width, b.height);
+  full << header << "\n";
+  char name[64], line[128];
+  for (int k = 0; k < frames; ++k) {
+    const OtbFrame f = frame(k);
+    write_image(out / "img" / frame_name(name, sizeof name, ("%04d." + ext).c_str(), k + 1), f.image);
+    const auto& b = f.box;
+    if (f.in_view)
+      std::snprintf(line, sizeof line, "%.3f,%.3f,%.3f,%.3f\n", b.x, b.y, b.width, b.height);
+    else
+      std::snprintf(line, sizeof line, "NaN,NaN,NaN,NaN\n");
     gt << line;
-    std::snprintf(line, sizeof line, "%d,%lld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.6f,%.6f\n", n,
-                  static_cast<long long>(f.utime), f.target_visible ? 1 : 0, b.x, b.y, b.width, b.height,
-                  f.target_center.x, f.target_center.y, f.target_scale, f.target_angle);
-    full << line;
+    full << f.full;
   }
+  return frames;
+}
+
+// The intruder's row of groundtruth_full.csv (frame,utime,visible,x,y,w,h,center_x,center_y,scale,angle_rad).
+std::string mono_row(int n, const sim::MonoFrame& f, int visible) {
+  char line[512];
+  const auto& b = f.target_box;
+  std::snprintf(line, sizeof line, "%d,%lld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.6f,%.6f", n,
+                static_cast<long long>(f.utime), visible, b.x, b.y, b.width, b.height, f.target_center.x,
+                f.target_center.y, f.target_scale, f.target_angle);
+  return line;
+}
+
+void export_intruder(const sim::IntruderScene& scene, const fs::path& out, const std::string& ext) {
+  const int n = export_otb(out, ext, scene.frame_count(),
+                           "frame,utime,visible,x,y,w,h,center_x,center_y,scale,angle_rad", [&](int k) {
+                             sim::MonoFrame f = scene.frame(k);
+                             const std::string row = mono_row(k + 1, f, f.target_visible ? 1 : 0) + "\n";
+                             return OtbFrame{std::move(f.image), f.target_box, true, row};
+                           });
   spdlog::info("wrote {} intruder frames to {}", n, out.string());
+}
+
+// `count` sequences <out>/<name>_01 ... with seeds seed, seed + 1, ...; in groundtruth.txt a frame
+// with less than min_visible of the box in view is NaN,NaN,NaN,NaN.
+void export_exits(sim::ExitsConfig cfg, const fs::path& out, const std::string& name, int count,
+                  const std::string& ext) {
+  const uint64_t seed = cfg.look.seed;
+  for (int i = 1; i <= count; ++i) {
+    cfg.look.seed = seed + static_cast<uint64_t>(i - 1);
+    const sim::ExitsScene scene(cfg);
+    char dir[256];
+    std::snprintf(dir, sizeof dir, "%s_%02d", name.c_str(), i);
+    int out_of_view = 0;
+    export_otb(out / dir, ext, scene.frame_count(),
+               "frame,utime,visible,x,y,w,h,center_x,center_y,scale,angle_rad,visible_fraction,event",
+               [&](int k) {
+                 sim::ExitsFrame f = scene.frame(k);
+                 char tail[64];
+                 std::snprintf(tail, sizeof tail, ",%.4f,%s\n", f.visible_fraction, f.event.c_str());
+                 out_of_view += f.in_view ? 0 : 1;
+                 return OtbFrame{std::move(f.mono.image), f.mono.target_box, f.in_view,
+                                 mono_row(k + 1, f.mono, f.in_view ? 1 : 0) + tail};
+               });
+    spdlog::info("wrote {} frames ({} out of view, seed {}) to {}", scene.frame_count(), out_of_view, cfg.look.seed,
+                 (out / dir).string());
+  }
 }
 
 }  // namespace
@@ -177,7 +233,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Aerie simulator: renders the simulated stereo flights and tracking sequences to disk."};
   app.require_subcommand(1);
   std::string config, out, ext = "png", log_level = "info";
-  int every = 1, max_frames = 0;
+  std::string name = "exits";
+  int every = 1, max_frames = 0, count = 6;
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")->capture_default_str();
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config, "YAML with world/rig/trajectory/intruder sections (config/sim/*.yaml)")
@@ -198,11 +255,26 @@ int main(int argc, char** argv) {
   add_config(intruder);
   intruder->add_option("--out", out, "output folder")->required();
   intruder->add_option("--ext", ext, "image format")->check(CLI::IsMember({"png", "jpg"}))->capture_default_str();
+  auto* exits = app.add_subcommand(
+      "exits",
+      "tracking sequences where the intruder aircraft leaves the image (fast pan, slow drift, behind a foreground "
+      "mast) and comes back: <out>/<name>_01... OTB-style folders, seeds seed, seed+1, ...; out-of-view frames are "
+      "NaN,NaN,NaN,NaN in groundtruth.txt (config/sim/exits.yaml)");
+  exits->add_option("--config", config, "YAML with an `exits` section (config/sim/exits.yaml)")
+      ->check(CLI::ExistingFile);
+  exits->add_option("--out", out, "output folder")->required();
+  exits->add_option("--count", count, "number of sequences")->capture_default_str()->check(CLI::Range(1, 99));
+  exits->add_option("--name", name, "sequence folder prefix")->capture_default_str();
+  exits->add_option("--ext", ext, "image format")->check(CLI::IsMember({"png", "jpg"}))->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   util::init_logging("aerie-sim", log_level);
 
   try {
     const util::Config cfg = load(config);
+    if (*exits) {
+      export_exits(sim::load_exits_config(cfg), out, name, count, ext);
+      return 0;
+    }
     if (*intruder) {
       sim::IntruderScene scene(sim::load_intruder_config(cfg.section("intruder")));
       export_intruder(scene, out, ext);

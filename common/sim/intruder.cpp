@@ -42,7 +42,8 @@ std::vector<Polygon> aircraft_parts() {
 
 }  // namespace
 
-IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
+cv::RNG IntruderScene::build(const std::vector<IntruderPose>& path) {
+  const IntruderConfig& cfg = config_;
   auto check = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("sim::IntruderConfig: " + what);
   };
@@ -66,9 +67,16 @@ IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
   for (const auto& p : jitter) max_jitter = std::max({max_jitter, std::abs(p.x), std::abs(p.y)});
   const int margin = static_cast<int>(std::ceil(max_jitter)) + 4;
 
-  // Sky: brighter towards the horizon, clouds from thresholded multi-scale noise.
-  const cv::Size sky_size(cfg.width + 2 * margin, cfg.height + 2 * margin);
-  const cv::Mat n = value_noise(sky_size, 0.5 * sky_size.width, 7, 0.55, mix_seed(cfg.seed, 12));
+  // Sky: brighter towards the horizon, clouds from thresholded multi-scale noise; it spans
+  // the image, the vibration and every pan of the path.
+  cv::Point2d lo(0, 0), hi(0, 0);
+  for (const auto& p : path) {
+    lo = {std::min(lo.x, p.pan.x), std::min(lo.y, p.pan.y)};
+    hi = {std::max(hi.x, p.pan.x), std::max(hi.y, p.pan.y)};
+  }
+  const cv::Size sky_size(cfg.width + 2 * margin + cvCeil(hi.x - lo.x), cfg.height + 2 * margin + cvCeil(hi.y - lo.y));
+  sky_origin_ = cv::Point2d(margin, margin) - lo;
+  const cv::Mat n = value_noise(sky_size, 0.5 * (cfg.width + 2 * margin), 7, 0.55, mix_seed(cfg.seed, 12));
   sky_.create(sky_size, CV_32FC3);
   const double cover = rng.uniform(0.38, 0.5);
   for (int y = 0; y < sky_size.height; ++y) {
@@ -126,6 +134,12 @@ IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
     cv::cvtColor(sprite_, sprite_, cv::COLOR_BGR2GRAY);
     cv::cvtColor(sky_, sky_, cv::COLOR_BGR2GRAY);
   }
+  jitter_ = std::move(jitter);
+  return rng;
+}
+
+IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
+  cv::RNG rng = build({});
 
   // Motion: crossing the image (direction from the seed) on a gentle arc, approaching
   // (growing), with a slow bank.
@@ -141,9 +155,16 @@ IntruderScene::IntruderScene(const IntruderConfig& cfg) : config_(cfg) {
     m.center = {left_to_right ? x : cfg.width - x, y0 + arc * std::sin(CV_PI * f)};
     m.angle = cfg.max_roll_deg * CV_PI / 180.0 * std::sin(2 * CV_PI * 0.8 * f + phase);
     if (!left_to_right) m.angle += CV_PI;  // nose to the left
-    m.jitter = jitter[k];
+    m.jitter = jitter_[k];
   }
-  background_margin_ = margin;
+}
+
+IntruderScene::IntruderScene(const IntruderConfig& cfg, const std::vector<IntruderPose>& path) : config_(cfg) {
+  config_.frames = static_cast<int>(path.size());
+  build(path);
+  motion_.resize(path.size());
+  for (size_t k = 0; k < path.size(); ++k)
+    motion_[k] = {path[k].center, path[k].scale, path[k].angle, jitter_[k], path[k].pan};
 }
 
 MonoFrame IntruderScene::frame(int k) const {
@@ -153,13 +174,13 @@ MonoFrame IntruderScene::frame(int k) const {
   const Motion& m = motion_[k];
   const cv::Size size(config_.width, config_.height);
   // Background shifted by the vibration (sub-pixel).
-  const cv::Matx23d Mb(1, 0, m.jitter.x - background_margin_, 0, 1, m.jitter.y - background_margin_);
+  const cv::Matx23d Mb(1, 0, m.jitter.x - m.pan.x - sky_origin_.x, 0, 1, m.jitter.y - m.pan.y - sky_origin_.y);
   cv::Mat img;
   cv::warpAffine(sky_, img, Mb, size, cv::INTER_LINEAR, cv::BORDER_REFLECT);
   // Aircraft: similarity sprite -> image.
   const double s = config_.wingspan_px * m.scale / sprite_span_px_;
   const double c = s * std::cos(m.angle), sn = s * std::sin(m.angle);
-  const cv::Point2d t = m.center + m.jitter;
+  const cv::Point2d t = m.center - m.pan + m.jitter;
   // image = [c -sn; sn c] (p - ref) + t   (counter-clockwise on screen is -angle in y-down)
   const cv::Matx23d M(c, sn, t.x - c * sprite_ref_.x - sn * sprite_ref_.y,
                       -sn, c, t.y + sn * sprite_ref_.x - c * sprite_ref_.y);

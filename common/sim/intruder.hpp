@@ -37,9 +37,22 @@ struct MonoFrame {
   double target_angle = 0.0;      // in-image rotation (rad, counter-clockwise)
 };
 
+// The aircraft's geometry in one frame, before the vibration: the similarity of the silhouette
+// (image position of its reference point, scale relative to wingspan_px, in-image rotation)
+// and the camera's pan over the sky (px; the sky and the aircraft move by -pan in the image).
+struct IntruderPose {
+  cv::Point2d center;
+  double scale = 1.0, angle = 0.0;
+  cv::Point2d pan;
+};
+
 class IntruderScene {
  public:
+  // The crossing: a path derived from the seed.
   explicit IntruderScene(const IntruderConfig& config);
+  // The same aircraft, sky and vibration following `path` (one pose a frame; config.frames is
+  // ignored); the sky is large enough for every pan of the path.
+  IntruderScene(const IntruderConfig& config, const std::vector<IntruderPose>& path);
   bool next(MonoFrame& frame);
   MonoFrame frame(int k) const;   // frame k directly (deterministic, no stepping state)
   int frame_count() const { return config_.frames; }
@@ -50,15 +63,20 @@ class IntruderScene {
     cv::Point2d center;
     double scale, angle;
     cv::Point2d jitter;
+    cv::Point2d pan;
   };
+  // Vibration, sky and sprite for `config_` and the pans of `path`; returns the seeded stream
+  // for what follows.
+  cv::RNG build(const std::vector<IntruderPose>& path);
   IntruderConfig config_;
   cv::Mat sky_;                     // background panorama, larger than the image
   cv::Mat sprite_, sprite_alpha_;   // aircraft at high resolution, CV_32F
   std::vector<cv::Point2d> outline_;  // silhouette polygon in sprite pixels
   cv::Point2d sprite_ref_;          // sprite pixel of the reference point
   double sprite_span_px_ = 0;       // wingspan in sprite pixels
+  std::vector<cv::Point2d> jitter_;  // the vibration of each frame
   std::vector<Motion> motion_;
-  int background_margin_ = 0;
+  cv::Point2d sky_origin_;           // sky pixel of the image origin at zero pan and vibration
   int next_ = 0;
 };
 

@@ -52,15 +52,46 @@ TrajectoryConfig load_trajectory_config(const util::Config& c) {
   return t;
 }
 
+namespace {
+
+// The intruder's look (sky, aircraft, camera, image), shared by the intruder and the exit sequences.
+SectionReader<IntruderConfig> read_look(const util::Config& c, IntruderConfig& i) {
+  using I = IntruderConfig;
+  SectionReader<I> r(c, i);
+  r("seed", &I::seed)("width", &I::width)("height", &I::height)("rate_hz", &I::rate_hz)(
+      "start_utime", &I::start_utime)("vibration_px", &I::vibration_px)("wingspan_px", &I::wingspan_px)(
+      "max_roll_deg", &I::max_roll_deg)("noise_sigma", &I::noise_sigma)("color", &I::color);
+  return r;
+}
+
+}  // namespace
+
 IntruderConfig load_intruder_config(const util::Config& c) {
   IntruderConfig i;
   using I = IntruderConfig;
-  SectionReader<I>(c, i)("seed", &I::seed)("width", &I::width)("height", &I::height)("frames", &I::frames)(
-      "rate_hz", &I::rate_hz)("start_utime", &I::start_utime)("vibration_px", &I::vibration_px)(
-      "wingspan_px", &I::wingspan_px)("scale_change", &I::scale_change)("max_roll_deg", &I::max_roll_deg)(
-      "noise_sigma", &I::noise_sigma)("color", &I::color)
-      .finish();
+  read_look(c, i)("frames", &I::frames)("scale_change", &I::scale_change).finish();
   return i;
+}
+
+ExitsConfig load_exits_config(const util::Config& config) {
+  config.check_keys({"exits.*"});
+  const util::Config c = config.section("exits");
+  ExitsConfig e;
+  using E = ExitsConfig;
+  SectionReader<E> r(c, e);
+  const SectionReader<IntruderConfig> look = read_look(c, e.look);
+  for (const auto& key : look.keys()) r.known(key);
+  r("scale_amplitude", &E::scale_amplitude)("exits", &E::exits)("kinds", &E::kinds)(
+      "in_frames_min", &E::in_frames_min)("in_frames_max", &E::in_frames_max)("out_frames_min", &E::out_frames_min)(
+      "out_frames_max", &E::out_frames_max)("min_visible", &E::min_visible)("pan_speed_px", &E::pan_speed_px)(
+      "drift_speed_px", &E::drift_speed_px)("reenter_elsewhere", &E::reenter_elsewhere)
+      .finish();
+  try {
+    validate_exits_config(e);
+  } catch (const std::invalid_argument& x) {
+    throw std::runtime_error(c.origin() + ": " + x.what());
+  }
+  return e;
 }
 
 SimulationConfig load_simulation_config(const util::Config& c) {

@@ -1,11 +1,12 @@
 #pragma once
 // The simulator's YAML configuration (config/sim/*.yaml): sections `world`, `rig`,
-// `trajectory` and `intruder`, every key optional (defaults are the structs' defaults),
+// `trajectory` and `intruder` (and `exits` on its own), every key optional (defaults are the structs' defaults),
 // unknown keys rejected with the file and key named. The world's `kind` (room | field)
 // chooses World::room or World::field (make_simulation builds it with World::make).
 #include <cstdint>
 #include <string>
 
+#include "common/sim/exits.hpp"
 #include "common/sim/intruder.hpp"
 #include "common/sim/simulation.hpp"
 #include "common/util/config.hpp"
@@ -31,6 +32,8 @@ WorldConfig load_world_config(const util::Config& section);
 RigConfig load_rig_config(const util::Config& section, RigConfig base = {});
 TrajectoryConfig load_trajectory_config(const util::Config& section);
 IntruderConfig load_intruder_config(const util::Config& section);
+// A file with the one section `exits` (config/sim/exits.yaml); other sections are refused.
+ExitsConfig load_exits_config(const util::Config& config);
 // The `world`, `rig` and `trajectory` sections of a file (or of an empty Config: defaults).
 SimulationConfig load_simulation_config(const util::Config& config);
 

@@ -27,6 +27,7 @@ class SectionReader {
     known_.push_back(key);
     return *this;
   }
+  const std::vector<std::string>& keys() const { return known_; }  // the keys named so far
   void finish() const {
     std::vector<std::string> open;  // each known key with whatever it holds (read by its own reader)
     for (const auto& k : known_) open.push_back(k + ".*");

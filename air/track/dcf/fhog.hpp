@@ -12,7 +12,8 @@ constexpr int kFhogChannels = 31;
 
 // image: 8-bit gray or BGR (the gradient of a colour pixel is that of its strongest channel).
 // Returns kFhogChannels CV_32F maps of floor(rows / cell) x floor(cols / cell) cells.
-// Throws std::invalid_argument for an empty image, a cell < 1 or an image under one cell.
+// Throws std::invalid_argument for an empty image, another type, a cell < 1 or an image under
+// one cell.
 std::vector<cv::Mat> fhog(const cv::Mat& image, int cell);
 
 }  // namespace aerie::track

@@ -7,7 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
 #include "common/camera/calibration_io.hpp"
 #include "tests/support/test_support.hpp"
@@ -78,6 +80,61 @@ TEST(AerieSim, TrackingSequencesAreOtbFolders) {
   EXPECT_EQ(count_files(dir / "intr" / "img"), 7);
   EXPECT_TRUE(fs::exists(dir / "intr" / "img" / "0007.jpg"));
   EXPECT_EQ(count_lines(dir / "intr" / "groundtruth.txt"), 7);
+}
+
+std::string read_all(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+std::vector<std::string> lines_of(const fs::path& p) {
+  std::ifstream f(p);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(f, line);) out.push_back(line);
+  return out;
+}
+
+TEST(AerieSim, ExitSequencesAreDeterministicWithNaNRowsOutOfView) {
+  const fs::path dir = aerie::test::scratch_dir("out");
+  const fs::path cfg = write_config(
+      dir, "exits: {width: 160, height: 120, wingspan_px: 24, in_frames_min: 3, in_frames_max: 5, "
+           "out_frames_min: 4, out_frames_max: 6, pan_speed_px: 20, drift_speed_px: 4}\n");
+  ASSERT_EQ(run("exits --config " + cfg.string() + " --out " + (dir / "a").string() + " --count 2"), 0);
+  ASSERT_EQ(run("exits --config " + cfg.string() + " --out " + (dir / "b").string() + " --count 2 --name exits"), 0);
+  for (const char* seq : {"exits_01", "exits_02"}) {
+    const fs::path a = dir / "a" / seq, b = dir / "b" / seq;
+    const auto gt = lines_of(a / "groundtruth.txt"), full = lines_of(a / "groundtruth_full.csv");
+    const int n = count_files(a / "img");
+    ASSERT_EQ(static_cast<int>(gt.size()), n);
+    ASSERT_EQ(static_cast<int>(full.size()), n + 1);
+    EXPECT_EQ(full[0], "frame,utime,visible,x,y,w,h,center_x,center_y,scale,angle_rad,visible_fraction,event");
+    EXPECT_NE(gt[0], "NaN,NaN,NaN,NaN");  // trackers start on the first frame
+    int nan_rows = 0;
+    for (int k = 0; k < n; ++k) {
+      // visible (3rd column) is 0 exactly where the visible fraction is under 1/4, and there
+      // groundtruth.txt has NaN; elsewhere its box is the full file's.
+      const std::string& row = full[k + 1];
+      const size_t c2 = row.find(',', row.find(',') + 1);
+      const bool visible = row[c2 + 1] == '1';
+      const double fraction = std::stod(row.substr(row.find_last_of(',', row.rfind(',') - 1) + 1));
+      EXPECT_EQ(visible, fraction >= 0.25) << seq << " " << row;
+      EXPECT_EQ(gt[k] == "NaN,NaN,NaN,NaN", !visible) << seq << " frame " << k + 1;
+      if (visible) {
+        EXPECT_EQ(row.substr(c2 + 3, gt[k].size()), gt[k]) << seq << " frame " << k + 1;
+      }
+      nan_rows += visible ? 0 : 1;
+    }
+    EXPECT_GE(nan_rows, 3 * 4);  // three exits of at least 4 frames
+    // Same seed, same bytes.
+    for (const auto& e : fs::recursive_directory_iterator(a)) {
+      if (!e.is_regular_file()) continue;
+      EXPECT_EQ(read_all(e.path()), read_all(b / fs::relative(e.path(), a))) << e.path();
+    }
+  }
+  EXPECT_NE(read_all(dir / "a" / "exits_01" / "groundtruth.txt"), read_all(dir / "a" / "exits_02" / "groundtruth.txt"));
+  EXPECT_NE(run("exits --config " + write_config(dir, "exits: {exitz: 2}\n").string() + " --out " + dir.string()), 0);
+  EXPECT_NE(run("exits --config " + write_config(dir, "intruder: {frames: 2}\n").string() + " --out " + dir.string()),
+            0);
 }
 
 TEST(AerieSim, BadInputsFail) {
