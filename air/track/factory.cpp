@@ -10,6 +10,7 @@
 
 #include "air/track/ct/ct.hpp"
 #include "air/track/dcf/dcf.hpp"
+#include "air/track/eco/eco.hpp"
 #ifdef AERIE_HAVE_IPSL
 #include "air/track/ipsl/ipsl.hpp"
 #endif
@@ -153,21 +154,17 @@ std::unique_ptr<Tracker> make_mil(const std::string& name, const util::Config& c
   return std::make_unique<DiscriminativeTracker>(name, d, mil_classifier_factory(mil), seed);
 }
 
-std::unique_ptr<Tracker> make_dcf(const util::Config& cfg) {
-  Params in(cfg, "dcf");
-  DcfParams p;
+// The keys DCF and ECO share (their parameter structs name the fields alike).
+template <typename P>
+void read_correlation_filter(Params& in, P& p) {
   in.read_in("cell", p.cell, 1, 16);
   in.read_in("padding", p.padding, 0.0, 10.0);
   in.read_in("template_area", p.template_area, 64.0, 1048576.0);
   in.read("output_sigma", p.output_sigma);
   in.read("lambda", p.lambda);
   in.read("learning_rate", p.learning_rate);
-  in.read("spatial_mask", p.spatial_mask);
   in.read("mask_scale", p.mask_scale);
   in.read_in("admm_iterations", p.admm_iterations, 0, 100);
-  in.read("admm_mu", p.admm_mu);
-  in.read("admm_beta", p.admm_beta);
-  in.read("admm_mu_max", p.admm_mu_max);
   in.read("hist_weight", p.hist_weight);
   in.read_in("hist_bins", p.hist_bins, 2, 256);
   in.read("hist_learning_rate", p.hist_learning_rate);
@@ -185,8 +182,37 @@ std::unique_ptr<Tracker> make_dcf(const util::Config& cfg) {
   in.read("redetection", p.redetection);
   in.read_in("lost_frames", p.lost_frames, 1, 100000);
   in.read("found_confidence", p.found_confidence);
+}
+
+std::unique_ptr<Tracker> make_dcf(const util::Config& cfg) {
+  Params in(cfg, "dcf");
+  DcfParams p;
+  read_correlation_filter(in, p);
+  in.read("spatial_mask", p.spatial_mask);
+  in.read("admm_mu", p.admm_mu);
+  in.read("admm_beta", p.admm_beta);
+  in.read("admm_mu_max", p.admm_mu_max);
   in.check_unknown();
   return std::make_unique<DcfTracker>(p);
+}
+
+std::unique_ptr<Tracker> make_eco(const util::Config& cfg) {
+  Params in(cfg, "eco");
+  EcoParams p;
+  read_correlation_filter(in, p);
+  in.read_in("hog_dims", p.hog_dims, 1, 32);
+  in.read_in("cn_dims", p.cn_dims, 0, 11);
+  in.read_in("samples", p.samples, 1, 200);
+  in.read_in("update_interval", p.update_interval, 1, 1000);
+  in.read("aberrance", p.aberrance);
+  in.read_in("newton_iterations", p.newton_iterations, 0, 50);
+  in.read("lost_confidence", p.lost_confidence);
+  in.read_in("lost_after", p.lost_after, 1, 1000);
+  in.read_in("global_interval", p.global_interval, 0, 100000);
+  in.read_in("global_pixels", p.global_pixels, 1024.0, 4194304.0);
+  in.read_in("global_candidates", p.global_candidates, 1, 20);
+  in.check_unknown();
+  return std::make_unique<EcoTracker>(p);
 }
 
 // OpenCV's trackers behind the Aerie interface. On a failed update the box stays where it
@@ -275,6 +301,7 @@ const std::vector<std::pair<std::string, Maker>>& registry() {
       return make_mil("am3", c, s, with_colour(multi_resolution()));
     });
     v.emplace_back("dcf", [](const util::Config& c, uint64_t) { return make_dcf(c); });
+    v.emplace_back("eco", [](const util::Config& c, uint64_t) { return make_eco(c); });
     auto reference = [&v](const std::string& name, std::function<std::pair<OpenCvTracker::Init, OpenCvTracker::Update>()> f) {
       v.emplace_back(name, [name, f](const util::Config& c, uint64_t) -> std::unique_ptr<Tracker> {
         Params(c, name).check_unknown();  // OpenCV defaults only

@@ -1,6 +1,6 @@
 #pragma once
 // Every tracker by name, configured from YAML (a config/track.yaml section):
-//   ours:        ipsl, ipsl-mr (when air/track/ipsl is built), ct, amcmr-ct, mil, am3
+//   ours:        ipsl, ipsl-mr (when air/track/ipsl is built), ct, amcmr-ct, mil, am3, dcf, eco
 //   references:  opencv-mil, opencv-kcf, opencv-csrt, opencv-tld, opencv-medianflow,
 //                opencv-boosting, opencv-mosse (OpenCV 4.6 defaults, for the benchmark)
 #include <cstdint>

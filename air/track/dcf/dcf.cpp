@@ -26,34 +26,9 @@ double refine(float left, float centre, float right) {
   return std::abs(d) < 1e-12 ? 0.0 : std::clamp(0.5 * (left - right) / d, -0.5, 0.5);
 }
 
-// Running average of a model: the sample itself at the first frame (or rate 1).
-void blend(cv::Mat& model, const cv::Mat& sample, double rate) {
-  if (model.empty() || rate >= 1)
-    model = sample;
-  else
-    model = (1 - rate) * model + rate * sample;
-}
 void blend(std::vector<cv::Mat>& model, const std::vector<cv::Mat>& sample, double rate) {
   model.resize(sample.size());
-  for (size_t c = 0; c < sample.size(); ++c) blend(model[c], sample[c], rate);
-}
-
-// Index of the colour histogram bin of each pixel.
-cv::Mat bin_index(const cv::Mat& patch, int bins) {
-  const int shift = static_cast<int>(std::round(std::log2(256.0 / bins)));
-  cv::Mat idx(patch.size(), CV_32S);
-  for (int y = 0; y < patch.rows; ++y) {
-    int* o = idx.ptr<int>(y);
-    if (patch.channels() == 1) {
-      const uchar* p = patch.ptr<uchar>(y);
-      for (int x = 0; x < patch.cols; ++x) o[x] = p[x] >> shift;
-    } else {
-      const cv::Vec3b* p = patch.ptr<cv::Vec3b>(y);
-      for (int x = 0; x < patch.cols; ++x)
-        o[x] = ((p[x][2] >> shift) * bins + (p[x][1] >> shift)) * bins + (p[x][0] >> shift);
-    }
-  }
-  return idx;
+  for (size_t c = 0; c < sample.size(); ++c) track::blend(model[c], sample[c], rate);
 }
 
 }  // namespace
@@ -115,64 +90,14 @@ DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& patch) cons
   return xf;
 }
 
-// Staple's per-pixel likelihood P(foreground | colour) = H_fg / (H_fg + H_bg).
-cv::Mat DcfTracker::colour_likelihood(const cv::Mat& patch) const {
-  const cv::Mat idx = bin_index(patch, p_.hist_bins);
-  cv::Mat out(patch.size(), CV_32F);
-  const float* fg = fg_hist_.ptr<float>();
-  const float* bg = bg_hist_.ptr<float>();
-  for (int y = 0; y < patch.rows; ++y) {
-    const int* i = idx.ptr<int>(y);
-    float* o = out.ptr<float>(y);
-    for (int x = 0; x < patch.cols; ++x) {
-      const float f = fg[i[x]], b = bg[i[x]];
-      o[x] = f + b > 0 ? f / (f + b) : 0.f;
-    }
-  }
-  return out;
-}
-
-void DcfTracker::learn_colour(const cv::Mat& patch, double rate) {
-  const cv::Mat idx = bin_index(patch, p_.hist_bins);
-  const double r = model_.width / window_.width;  // model pixels per image pixel at scale 1
-  const cv::Size2d target = target_ * r;
-  const double shrink = p_.inner_padding * (target.width + target.height) / 2;
-  const cv::Point2d c(model_.width / 2.0, model_.height / 2.0);
-  auto rect = [&](cv::Size2d s) {
-    return cv::Rect(cvRound(c.x - s.width / 2), cvRound(c.y - s.height / 2), std::max(1, cvRound(s.width)),
-                    std::max(1, cvRound(s.height))) &
-           cv::Rect(0, 0, model_.width, model_.height);
-  };
-  const cv::Rect fg_rect = rect({std::max(1.0, target.width - shrink), std::max(1.0, target.height - shrink)});
-  const cv::Rect target_rect = rect(target);
-  const int n = patch.channels() == 1 ? p_.hist_bins : p_.hist_bins * p_.hist_bins * p_.hist_bins;
-  cv::Mat fg = cv::Mat::zeros(1, n, CV_32F), bg = cv::Mat::zeros(1, n, CV_32F);
-  float nf = 0, nb = 0;
-  for (int y = 0; y < patch.rows; ++y) {
-    const int* i = idx.ptr<int>(y);
-    for (int x = 0; x < patch.cols; ++x) {
-      if (fg_rect.contains({x, y})) {
-        fg.at<float>(i[x]) += 1;
-        ++nf;
-      } else if (!target_rect.contains({x, y})) {
-        bg.at<float>(i[x]) += 1;
-        ++nb;
-      }
-    }
-  }
-  if (nf > 0) fg /= nf;
-  if (nb > 0) bg /= nb;
-  blend(fg_hist_, fg, rate);
-  blend(bg_hist_, bg, rate);
-}
-
 // Every model learns the window at the current location and scale; the first frame
 // initialises them.
 void DcfTracker::learn(const cv::Mat& frame, bool first) {
   const cv::Mat patch = window_patch(frame, pos_);
   learn_translation(translation_features(patch), first ? 1.0 : p_.learning_rate);
   scale_filter_.learn(frame, pos_, scale_, first ? 1.0 : p_.scale_learning_rate);
-  if (p_.hist_weight > 0) learn_colour(patch, first ? 1.0 : p_.hist_learning_rate);
+  if (p_.hist_weight > 0)
+    colour_.learn(patch, target_ * (model_.width / window_.width), first ? 1.0 : p_.hist_learning_rate);
 }
 
 void DcfTracker::learn_translation(const Spectrum& xf, double rate) {
@@ -194,36 +119,15 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   frames_ = 0;
   unconfident_frames_ = 0;
 
-  // Translation window: target + padding * mean side, resized to about template_area pixels,
-  // a whole number of cells of FFT-friendly count.
-  const double pad = p_.padding * (target_.width + target_.height) / 2;
-  const cv::Size2d window(target_.width + pad, target_.height + pad);
-  const double r = std::sqrt(p_.template_area / window.area());
-  const cv::Size cells(cv::getOptimalDFTSize(std::max(4, cvRound(window.width * r / p_.cell))),
-                       cv::getOptimalDFTSize(std::max(4, cvRound(window.height * r / p_.cell))));
-  model_ = cells * p_.cell;
-  window_ = {model_.width / r, model_.height / r};
-  cv::createHanningWindow(hann_, cells, CV_32F);
-  // Spatial support of the constrained filter: the target box x mask_scale (rounded up to
-  // cells), centred.
-  mask_ = cv::Mat::zeros(cells, CV_32F);
-  const double support_px = p_.mask_scale * r / p_.cell;
-  const cv::Size support(std::min(cells.width, static_cast<int>(std::ceil(target_.width * support_px))),
-                         std::min(cells.height, static_cast<int>(std::ceil(target_.height * support_px))));
-  mask_(cv::Rect((cells.width - support.width) / 2, (cells.height - support.height) / 2, support.width, support.height))
-      .setTo(1);
-
-  // Gaussian label centred on shift (0, 0), circularly.
-  const double sigma = std::sqrt(target_.area()) * r / p_.cell * p_.output_sigma;
-  cv::Mat y(cells, CV_32F);
-  for (int i = 0; i < cells.height; ++i)
-    for (int j = 0; j < cells.width; ++j) {
-      const double di = circular(i, cells.height), dj = circular(j, cells.width);
-      y.at<float>(i, j) = static_cast<float>(std::exp(-0.5 * (di * di + dj * dj) / (sigma * sigma)));
-    }
-  cv::dft(y, yf_, cv::DFT_COMPLEX_OUTPUT);
+  const FilterWindow w = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
+  model_ = w.model;
+  window_ = w.window;
+  hann_ = w.hann;
+  mask_ = w.mask;
+  yf_ = w.yf;
 
   scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
+  colour_ = ColourHistogram(p_.hist_bins, p_.inner_padding);
 
   learn(frame, true);
   initialised_ = true;
@@ -248,7 +152,6 @@ DcfTracker::Detection DcfTracker::detect(const cv::Mat& frame, cv::Point2d centr
   Detection d;
   d.centre = centre;
   cv::dft(rf, d.response, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-  const cv::Size cells = d.response.size();
 
   // Reliability of the filter alone: its peak and the average peak-to-correlation energy
   // (APCE, Wang et al. 2017) = (max - min)^2 / mean((F - min)^2).
@@ -258,21 +161,8 @@ DcfTracker::Detection DcfTracker::detect(const cv::Mat& frame, cv::Point2d centr
            std::max(1e-12, cv::mean((d.response - cf_min).mul(d.response - cf_min))[0]);
 
   // Staple: merge with the mean colour likelihood of a target-sized box at each shift.
-  if (p_.hist_weight > 0) {
-    cv::Mat box;
-    const double r = model_.width / window_.width;
-    cv::boxFilter(colour_likelihood(patch), box, CV_32F,
-                  cv::Size(std::max(1, cvRound(target_.width * r)), std::max(1, cvRound(target_.height * r))),
-                  cv::Point(-1, -1), true, cv::BORDER_CONSTANT);
-    const float w = static_cast<float>(p_.hist_weight);
-    for (int i = 0; i < cells.height; ++i)
-      for (int j = 0; j < cells.width; ++j) {
-        const int py = std::clamp(model_.height / 2 + circular(i, cells.height) * p_.cell, 0, model_.height - 1);
-        const int px = std::clamp(model_.width / 2 + circular(j, cells.width) * p_.cell, 0, model_.width - 1);
-        float& v = d.response.at<float>(i, j);
-        v = (1 - w) * v + w * box.at<float>(py, px);
-      }
-  }
+  if (p_.hist_weight > 0)
+    colour_.merge(d.response, patch, target_ * (model_.width / window_.width), p_.cell, p_.hist_weight);
   return d;
 }
 
@@ -314,21 +204,16 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   bool redetected = false;
   int windows = 1;
   if (p_.redetection && unconfident_frames_ >= p_.lost_frames) {
-    const cv::Size2d step = window_ * (0.75 * scale_);
-    for (int i = -1; i <= 1; ++i)
-      for (int j = -1; j <= 1; ++j) {
-        if (i == 0 && j == 0) continue;
-        const cv::Point2d c(std::clamp(pos_.x + j * step.width, 0.0, frame.cols - 1.0),
-                            std::clamp(pos_.y + i * step.height, 0.0, frame.rows - 1.0));
-        Detection candidate = detect(frame, c);
-        ++windows;
-        const double conf = confidence_of(candidate);
-        if (conf >= p_.found_confidence && conf > confidence) {
-          d = std::move(candidate);
-          confidence = conf;
-          redetected = true;
-        }
+    for (const cv::Point2d& c : neighbour_windows(pos_, window_ * scale_, frame.size())) {
+      Detection candidate = detect(frame, c);
+      ++windows;
+      const double conf = confidence_of(candidate);
+      if (conf >= p_.found_confidence && conf > confidence) {
+        d = std::move(candidate);
+        confidence = conf;
+        redetected = true;
       }
+    }
   }
   mean_peak_ += p_.confidence_rate * (d.peak - mean_peak_);
   mean_apce_ += p_.confidence_rate * (d.apce - mean_apce_);

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "air/track/dcf/colour_histogram.hpp"
 #include "air/track/dcf/filters.hpp"
 #include "air/track/dcf/scale_filter.hpp"
 #include "air/track/tracker.hpp"
@@ -98,9 +99,7 @@ class DcfTracker : public Tracker {
   cv::Point2d peak_location(const Detection& d) const;
   cv::Mat window_patch(const cv::Mat& frame, cv::Point2d centre) const;  // at scale_, resized
   Spectrum translation_features(const cv::Mat& patch) const;
-  cv::Mat colour_likelihood(const cv::Mat& patch) const;
   void learn_translation(const Spectrum& xf, double rate);
-  void learn_colour(const cv::Mat& patch, double rate);
   void learn(const cv::Mat& frame, bool first);
 
   DcfParams p_;
@@ -121,7 +120,7 @@ class DcfTracker : public Tracker {
 
   ScaleFilter scale_filter_;
 
-  cv::Mat fg_hist_, bg_hist_;  // colour histograms, normalised
+  ColourHistogram colour_;
   double mean_peak_ = 0, mean_apce_ = 0;
   int frames_ = 0;
   int unconfident_frames_ = 0;  // in a row

@@ -10,15 +10,14 @@ using Complex = std::complex<float>;
 Complex* cptr(cv::Mat& m) { return m.ptr<Complex>(); }
 const Complex* cptr(const cv::Mat& m) { return m.ptr<Complex>(); }
 
-// Running average of a model: the sample itself at the first frame (or rate 1).
+}  // namespace
+
 void blend(cv::Mat& model, const cv::Mat& sample, double rate) {
   if (model.empty() || rate >= 1)
     model = sample;
   else
     model = (1 - rate) * model + rate * sample;
 }
-
-}  // namespace
 
 cv::Mat masked_filter(const cv::Mat& yx, const cv::Mat& sxx, const cv::Mat& mask, const AdmmSettings& s) {
   const size_t n = yx.total();

@@ -4,6 +4,10 @@
 
 namespace aerie::track {
 
+// Running average of a model: model <- (1 - rate) model + rate sample; the sample itself when
+// the model is empty or rate >= 1.
+void blend(cv::Mat& model, const cv::Mat& sample, double rate);
+
 // A multi-channel linear correlation filter (Danelljan et al. 2014, eqs. 4-5) on spectra
 // stacked one feature channel per row (CV_32FC2): running numerator A = conj(Y) X per row and
 // denominator B = sum over rows of |X|^2; response spectrum sum over rows of conj(A) Z / (B + lambda).

@@ -33,4 +33,44 @@ std::vector<float> hann(int n) {
   return w;
 }
 
+FilterWindow filter_window(cv::Size2d target, double padding, double template_area, int cell, double mask_scale,
+                           double output_sigma) {
+  FilterWindow w;
+  const double pad = padding * (target.width + target.height) / 2;
+  const cv::Size2d window(target.width + pad, target.height + pad);
+  const double r = std::sqrt(template_area / window.area());
+  w.cells = {cv::getOptimalDFTSize(std::max(4, cvRound(window.width * r / cell))),
+             cv::getOptimalDFTSize(std::max(4, cvRound(window.height * r / cell)))};
+  w.model = w.cells * cell;
+  w.window = {w.model.width / r, w.model.height / r};
+  cv::createHanningWindow(w.hann, w.cells, CV_32F);
+  w.mask = cv::Mat::zeros(w.cells, CV_32F);
+  const double support_px = mask_scale * r / cell;
+  const cv::Size support(std::min(w.cells.width, static_cast<int>(std::ceil(target.width * support_px))),
+                         std::min(w.cells.height, static_cast<int>(std::ceil(target.height * support_px))));
+  w.mask(cv::Rect((w.cells.width - support.width) / 2, (w.cells.height - support.height) / 2, support.width,
+                  support.height))
+      .setTo(1);
+  const double sigma = std::sqrt(target.area()) * r / cell * output_sigma;
+  cv::Mat y(w.cells, CV_32F);
+  for (int i = 0; i < w.cells.height; ++i)
+    for (int j = 0; j < w.cells.width; ++j) {
+      const double di = circular(i, w.cells.height), dj = circular(j, w.cells.width);
+      y.at<float>(i, j) = static_cast<float>(std::exp(-0.5 * (di * di + dj * dj) / (sigma * sigma)));
+    }
+  cv::dft(y, w.yf, cv::DFT_COMPLEX_OUTPUT);
+  return w;
+}
+
+std::vector<cv::Point2d> neighbour_windows(cv::Point2d pos, cv::Size2d window, cv::Size image) {
+  std::vector<cv::Point2d> out;
+  const cv::Size2d step = window * 0.75;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      if (i != 0 || j != 0)
+        out.emplace_back(std::clamp(pos.x + j * step.width, 0.0, image.width - 1.0),
+                         std::clamp(pos.y + i * step.height, 0.0, image.height - 1.0));
+  return out;
+}
+
 }  // namespace aerie::track

@@ -1,4 +1,4 @@
-// Aerie's trackers (CT, AMCMR-CT, MIL, AM3, DCF) follow synthetic sequences with known motion;
+// Aerie's trackers (CT, AMCMR-CT, MIL, AM3, DCF, ECO) follow synthetic sequences with known motion;
 // bad input is rejected with a clear error; the same seed gives the same track. The options of
 // the discriminative framework (flow prediction, re-detection) are tested on its four trackers.
 #include <gtest/gtest.h>
@@ -12,11 +12,12 @@ using aerie::track::test::Scene;
 
 namespace {
 
-const char* kTrackers[] = {"ct", "amcmr-ct", "mil", "am3", "dcf"};
+const char* kTrackers[] = {"ct", "amcmr-ct", "mil", "am3", "dcf", "eco"};
 const char* kFramework[] = {"ct", "amcmr-ct", "mil", "am3"};  // air/track/pyramid/discriminative.hpp
 
 struct Result {
   double mean_error = 0, max_error = 0, final_scale = 1;
+  int unflagged_misses = 0;  // frames more than a quarter of the target's width off, not flagged lost
 };
 
 Result follow(const std::string& name, const Scene& scene, const std::vector<Motion>& motion,
@@ -30,6 +31,7 @@ Result follow(const std::string& name, const Scene& scene, const std::vector<Mot
     r.mean_error += e / (motion.size() - 1);
     r.max_error = std::max(r.max_error, e);
     r.final_scale = s.pose.scale;
+    r.unflagged_misses += e > scene.target_size().width / 4.0 && !s.lost;
   }
   return r;
 }
@@ -106,8 +108,14 @@ TEST_P(TrackerFollows, Rotation) {
                           m.theta += 2 * M_PI / 180;
                           m.centre += cv::Point2d(1.5, 1);
                         }));
+  // The correlation filters' boxes do not rotate (translation and scale filters only). DCF's
+  // centre wanders more; ECO's filter, which learns only every 6th frame, loses this fine texture
+  // after about 10 degrees: it must then say so.
+  if (std::string(GetParam()) == "eco") {
+    EXPECT_EQ(r.unflagged_misses, 0);
+    return;
+  }
   EXPECT_LT(r.mean_error, 4.0);
-  // DCF's box does not rotate (translation and scale filters only): its centre wanders more.
   EXPECT_LT(r.max_error, std::string(GetParam()) == "dcf" ? 10.0 : 8.0);
 }
 

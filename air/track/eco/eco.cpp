@@ -1,0 +1,350 @@
+#include "air/track/eco/eco.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "air/track/dcf/fhog.hpp"
+#include "air/track/dcf/window.hpp"
+#include "air/track/eco/colour_names.hpp"
+#include "air/track/eco/newton.hpp"
+#include "air/track/eco/projection.hpp"
+
+namespace aerie::track {
+namespace {
+
+using Complex = std::complex<float>;
+constexpr int kHogBlock = kFhogChannels + 1;  // FHOG and the grey level
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("eco: " + what);
+}
+
+// A frame whose three channels are equal (a grey sequence stored as BGR) has no colour.
+bool has_colour(const cv::Mat& frame, const cv::Rect& roi) {
+  if (frame.channels() != 3) return false;
+  std::vector<cv::Mat> ch;
+  cv::split(frame(roi), ch);
+  return cv::norm(ch[0], ch[1], cv::NORM_INF) > 0 || cv::norm(ch[1], ch[2], cv::NORM_INF) > 0;
+}
+
+// spectrum * exp(-i 2 pi (k dx / W + l dy / H)): the signal moved by (dx, dy) cells, s(x - d).
+cv::Mat shifted(const cv::Mat& spectrum, cv::Point2d d) {
+  cv::Mat out(spectrum.size(), CV_32FC2);
+  const int w = spectrum.cols, h = spectrum.rows;
+  std::vector<Complex> ex(w);
+  for (int k = 0; k < w; ++k) ex[k] = std::polar(1.f, static_cast<float>(-2 * CV_PI * circular(k, w) * d.x / w));
+  for (int l = 0; l < h; ++l) {
+    const Complex ey = std::polar(1.f, static_cast<float>(-2 * CV_PI * circular(l, h) * d.y / h));
+    const Complex* s = spectrum.ptr<Complex>(l);
+    Complex* o = out.ptr<Complex>(l);
+    for (int k = 0; k < w; ++k) o[k] = s[k] * ex[k] * ey;
+  }
+  return out;
+}
+
+}  // namespace
+
+void EcoParams::validate() const {
+  require(cell >= 1, "cell must be >= 1");
+  require(padding >= 0 && std::isfinite(padding), "padding must be >= 0");
+  require(template_area >= 16.0 * cell * cell, "template_area must hold at least 4x4 cells");
+  require(output_sigma > 0 && lambda > 0 && scale_lambda > 0 && scale_sigma > 0, "sigmas and lambdas must be > 0");
+  require(mask_scale > 0, "mask_scale must be > 0");
+  require(admm_iterations >= 0, "admm_iterations must be >= 0");
+  require(hog_dims >= 1 && hog_dims <= kHogBlock, "hog_dims must be in [1, 32]");
+  require(cn_dims >= 0 && cn_dims <= kColourNames, "cn_dims must be in [0, 11]");
+  require(samples >= 1, "samples must be >= 1");
+  for (double r : {learning_rate, scale_learning_rate, confidence_rate})
+    require(r > 0 && r <= 1, "learning rates must be in (0, 1]");
+  require(update_interval >= 1, "update_interval must be >= 1");
+  require(aberrance >= 0 && std::isfinite(aberrance), "aberrance must be >= 0");
+  require(newton_iterations >= 0, "newton_iterations must be >= 0");
+  require(hist_weight >= 0 && hist_weight <= 1, "hist_weight must be in [0, 1]");
+  require(hist_bins >= 2 && hist_bins <= 256 && (hist_bins & (hist_bins - 1)) == 0,
+          "hist_bins must be a power of two in [2, 256]");
+  require(hist_learning_rate > 0 && hist_learning_rate <= 1, "hist_learning_rate must be in (0, 1]");
+  require(inner_padding >= 0 && inner_padding < 1, "inner_padding must be in [0, 1)");
+  require(scales >= 1 && scale_step > 1 && scale_model_area >= 4.0 * cell * cell * 4, "bad scale filter settings");
+  require(min_scale > 0 && max_scale >= min_scale, "need 0 < min_scale <= max_scale");
+  require(update_confidence >= 0 && update_confidence <= 1 && found_confidence >= 0 && found_confidence <= 1,
+          "update_confidence and found_confidence must be in [0, 1]");
+  require(lost_frames >= 1, "lost_frames must be >= 1");
+  require(lost_confidence >= 0 && lost_confidence <= 1, "lost_confidence must be in [0, 1]");
+  require(lost_after >= 1, "lost_after must be >= 1");
+  require(global_interval >= 0, "global_interval must be >= 0");
+  require(global_pixels >= 1024, "global_pixels must be >= 1024");
+  require(global_candidates >= 1, "global_candidates must be >= 1");
+}
+
+EcoTracker::EcoTracker(EcoParams params, std::string name) : p_(params), name_(std::move(name)) { p_.validate(); }
+
+cv::Mat EcoTracker::raw_features(const cv::Mat& image, cv::Size& cells) const {
+  const std::vector<cv::Mat> hog = fhog(image, p_.cell);
+  cells = hog[0].size();
+  const cv::Mat whole = image(cv::Rect(0, 0, cells.width * p_.cell, cells.height * p_.cell));
+  const int n = cells.area();
+  cv::Mat raw(kHogBlock + (colour_ ? kColourNames : 0), n, CV_32F);
+  for (int c = 0; c < kFhogChannels; ++c) hog[c].reshape(1, 1).copyTo(raw.row(c));
+  cv::Mat grey;  // mean grey level per cell, centred
+  cv::resize(to_gray(whole), grey, cells, 0, 0, cv::INTER_AREA);
+  grey.convertTo(raw.row(kFhogChannels).reshape(1, cells.height), CV_32F, 1.0 / 255, -0.5);
+  if (colour_) {
+    const std::vector<cv::Mat> cn = colour_names(whole, p_.cell);
+    for (int c = 0; c < kColourNames; ++c) cn[c].reshape(1, 1).copyTo(raw.row(kHogBlock + c));
+  }
+  return raw;
+}
+
+std::vector<cv::Mat> EcoTracker::projected(const cv::Mat& raw, cv::Size cells) const {
+  std::vector<cv::Mat> maps;
+  auto add = [&](const cv::Mat& block, const cv::Mat& P) {
+    const cv::Mat x = project(block, P);
+    for (int c = 0; c < x.rows; ++c) maps.push_back(x.row(c).clone().reshape(1, cells.height));
+  };
+  add(raw.rowRange(0, kHogBlock), hog_projection_);
+  if (colour_ && !cn_projection_.empty()) add(raw.rowRange(kHogBlock, raw.rows), cn_projection_);
+  return maps;
+}
+
+std::vector<cv::Mat> EcoTracker::spectra(const std::vector<cv::Mat>& maps) const {
+  std::vector<cv::Mat> xf(maps.size());
+  for (size_t c = 0; c < maps.size(); ++c) cv::dft(maps[c].mul(hann_), xf[c], cv::DFT_COMPLEX_OUTPUT);
+  return xf;
+}
+
+EcoTracker::Detection EcoTracker::detect(const cv::Mat& frame, cv::Point2d centre) const {
+  Detection d;
+  d.centre = centre;
+  cv::Size cells;
+  d.patch = subwindow(frame, centre, window_ * scale_, model_);
+  d.zf = spectra(projected(raw_features(d.patch, cells), cells));
+  // Response spectrum sum_c G_c Z_c (the filters' convention: G = Y conj(X) / |X|^2).
+  d.rf = cv::Mat(cells_, CV_32FC2, cv::Scalar::all(0));
+  Complex* out = d.rf.ptr<Complex>();
+  for (size_t c = 0; c < d.zf.size(); ++c) {
+    const Complex* z = d.zf[c].ptr<Complex>();
+    const Complex* g = filter_[c].ptr<Complex>();
+    for (size_t k = 0; k < d.rf.total(); ++k) out[k] += g[k] * z[k];
+  }
+  cv::dft(d.rf, d.response, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+  // Peak and average peak-to-correlation energy (APCE, Wang et al. 2017).
+  double lo;
+  cv::minMaxLoc(d.response, &lo, &d.peak);
+  d.apce = (d.peak - lo) * (d.peak - lo) / std::max(1e-12, cv::mean((d.response - lo).mul(d.response - lo))[0]);
+  if (p_.hist_weight > 0) colour_model_.merge(d.response, d.patch, target_in_model(), p_.cell, p_.hist_weight);
+  cv::minMaxLoc(d.response, nullptr, nullptr, nullptr, &d.grid_peak);
+  return d;
+}
+
+double EcoTracker::confidence_of(const Detection& d) const {
+  return std::clamp(std::min(d.peak / mean_peak_, d.apce / mean_apce_), 0.0, 1.0);
+}
+
+cv::Point2d EcoTracker::peak_offset(const Detection& d) const {
+  const cv::Point2d grid(d.grid_peak);
+  const cv::Point2d peak = newton_peak(d.rf, grid, p_.newton_iterations);
+  const cv::Point2d moved = peak - grid;  // Newton's refinement: within a cell or two of the grid peak
+  return {circular(d.grid_peak.x, cells_.width) + moved.x, circular(d.grid_peak.y, cells_.height) + moved.y};
+}
+
+void EcoTracker::add_sample(const Detection& d, cv::Point2d shift) {
+  Sample s;
+  for (const auto& z : d.zf) s.xf.push_back(shifted(z, -shift));  // ECO: the detection's sample, re-centred
+  // ARCF: this frame's response (the filter before this update), aligned on its peak, scaled to
+  // peak 1, mixed into the label: the new filter is kept from changing the response abruptly.
+  const cv::Mat aligned = shifted(d.rf, -shift) / std::max(d.peak, 1e-12);
+  s.yf = p_.aberrance > 0 ? (yf_ + p_.aberrance * aligned) / (1 + p_.aberrance) : yf_;
+  samples_.add(s);
+}
+
+// The filter from the whole sample space: per channel sum_m pi_m Y_m conj(X_m) and
+// sum_m pi_m |X_m|^2, then CSR-DCF's constrained solution.
+void EcoTracker::train() {
+  const auto& comps = samples_.components();
+  const auto& w = samples_.weights();
+  const size_t channels = comps[0].xf.size(), n = static_cast<size_t>(cells_.area());
+  filter_.resize(channels);
+  const AdmmSettings admm{p_.lambda, p_.admm_iterations, 5, 3, 20};
+  for (size_t c = 0; c < channels; ++c) {
+    cv::Mat yx(cells_, CV_32FC2, cv::Scalar::all(0)), sxx(cells_, CV_32F, cv::Scalar(0));
+    Complex* a = yx.ptr<Complex>();
+    float* e = sxx.ptr<float>();
+    for (size_t m = 0; m < comps.size(); ++m) {
+      const Complex* x = comps[m].xf[c].ptr<Complex>();
+      const Complex* y = comps[m].yf.ptr<Complex>();
+      const float wm = static_cast<float>(w[m]);
+      for (size_t k = 0; k < n; ++k) {
+        a[k] += wm * y[k] * std::conj(x[k]);
+        e[k] += wm * std::norm(x[k]);
+      }
+    }
+    filter_[c] = masked_filter(yx, sxx, mask_, admm);
+  }
+  since_training_ = 0;
+}
+
+void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
+  validate_init(frame, box);
+  frame_size_ = frame.size();
+  pos_ = {box.x + box.width / 2, box.y + box.height / 2};
+  target_ = box.size();
+  scale_ = 1;
+  frames_ = since_training_ = unconfident_frames_ = doubtful_frames_ = 0;
+  const cv::Rect inside = cv::Rect(box) & cv::Rect(0, 0, frame.cols, frame.rows);
+  colour_ = p_.cn_dims > 0 && has_colour(frame, inside.empty() ? cv::Rect(0, 0, frame.cols, frame.rows) : inside);
+
+  const FilterWindow w = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
+  cells_ = w.cells;
+  model_ = w.model;
+  window_ = w.window;
+  hann_ = w.hann;
+  mask_ = w.mask;
+  yf_ = w.yf;
+
+  // Factorised convolution: each block's projection from the first window's cells (PCA).
+  cv::Size cells;
+  const cv::Mat raw = raw_features(subwindow(frame, pos_, window_, model_), cells);
+  hog_projection_ = pca_projection(raw.rowRange(0, kHogBlock), p_.hog_dims);
+  cn_projection_ = colour_ ? pca_projection(raw.rowRange(kHogBlock, raw.rows), p_.cn_dims) : cv::Mat();
+
+  // ECO's minimum weight: a sample older than twice the capacity at the learning rate.
+  samples_ = SampleSpace(p_.samples, p_.learning_rate,
+                         p_.learning_rate * std::pow(1 - p_.learning_rate, 2.0 * p_.samples));
+  samples_.add({spectra(projected(raw, cells)), yf_});
+  train();
+  scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
+  scale_filter_.learn(frame, pos_, scale_, 1.0);
+  colour_model_ = ColourHistogram(p_.hist_bins, p_.inner_padding);
+  if (p_.hist_weight > 0) colour_model_.learn(subwindow(frame, pos_, window_, model_), target_in_model(), 1.0);
+  initialised_ = true;
+}
+
+bool EcoTracker::search_whole_image(const cv::Mat& frame, Detection& best, double& confidence) const {
+  // The frame at the filter's resolution (model pixels per image pixel), reduced to at most
+  // global_pixels pixels: the coarse level.
+  const double r = model_.width / (window_.width * scale_);
+  const double q = std::min(1.0, std::sqrt(p_.global_pixels / (frame.total() * r * r)));
+  const cv::Size size(cvRound(frame.cols * r * q), cvRound(frame.rows * r * q));
+  if (size.width < 4 * p_.cell || size.height < 4 * p_.cell) return false;
+  cv::Mat coarse;
+  cv::resize(frame, coarse, size, 0, 0, r * q < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  cv::Size cells;
+  const std::vector<cv::Mat> maps = projected(raw_features(coarse, cells), cells);
+
+  // The filter as a spatial kernel around the window's centre cell c0: a target at cell p of the
+  // map scores sum_u g(c0 + u) F(p - u) (the window's circular convolution), resized by q.
+  const cv::Point c0(cells_.width / 2, cells_.height / 2);
+  const int rx = std::min(cells_.width / 2, static_cast<int>(std::ceil(target_.width * scale_ * r / p_.cell / 2)) + 1);
+  const int ry = std::min(cells_.height / 2, static_cast<int>(std::ceil(target_.height * scale_ * r / p_.cell / 2)) + 1);
+  cv::Mat score(cells, CV_32F, cv::Scalar(0));
+  for (size_t c = 0; c < maps.size(); ++c) {
+    cv::Mat g;
+    cv::dft(filter_[c], g, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+    cv::Mat k(2 * ry + 1, 2 * rx + 1, CV_32F);
+    for (int v = -ry; v <= ry; ++v)  // flipped for filter2D's correlation: k(v) = g(c0 - v)
+      for (int u = -rx; u <= rx; ++u)
+        k.at<float>(v + ry, u + rx) =
+            g.at<float>((c0.y - v + cells_.height) % cells_.height, (c0.x - u + cells_.width) % cells_.width);
+    if (q < 1) cv::resize(k, k, cv::Size(std::max(1, cvRound(k.cols * q)), std::max(1, cvRound(k.rows * q))), 0, 0,
+                          cv::INTER_AREA);
+    cv::Mat s;
+    cv::filter2D(maps[c], s, CV_32F, k, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+    score += s;
+  }
+  // The best few local maxima, each verified by a full-resolution detection there.
+  bool found = false;
+  const int suppress = std::max(1, cvRound(std::max(rx, ry) * q));
+  for (int i = 0; i < p_.global_candidates; ++i) {
+    cv::Point at;
+    double v;
+    cv::minMaxLoc(score, nullptr, &v, nullptr, &at);
+    if (!std::isfinite(v) || v <= -1e30) break;
+    cv::rectangle(score, cv::Rect(at.x - suppress, at.y - suppress, 2 * suppress + 1, 2 * suppress + 1),
+                  cv::Scalar(-1e31), cv::FILLED);
+    // Verified where the full-resolution response of a window there peaks (a second window
+    // centred on that peak: the coarse position is a few pixels off).
+    auto clamped = [&](cv::Point2d c) {
+      return cv::Point2d(std::clamp(c.x, 0.0, frame.cols - 1.0), std::clamp(c.y, 0.0, frame.rows - 1.0));
+    };
+    const cv::Point2d c((at.x + 0.5) * p_.cell / (r * q), (at.y + 0.5) * p_.cell / (r * q));
+    Detection d = detect(frame, clamped(c));
+    d = detect(frame, clamped(d.centre + peak_offset(d) * (p_.cell / r)));
+    const double conf = confidence_of(d);
+    if (conf >= p_.found_confidence && conf > confidence) {
+      best = std::move(d);
+      confidence = conf;
+      found = true;
+    }
+  }
+  return found;
+}
+
+TrackState EcoTracker::update(const cv::Mat& frame) {
+  if (!initialised_) throw std::invalid_argument(name_ + ": update() before init()");
+  validate_update(name_, frame, frame_size_);
+
+  Detection d = detect(frame, pos_);
+  if (++frames_ == 1) {
+    mean_peak_ = d.peak;
+    mean_apce_ = d.apce;
+  }
+  double confidence = confidence_of(d);
+
+  // Re-detection while lost: the 8 neighbouring windows (3/4 of a window apart) every frame,
+  // the whole image every global_interval frames.
+  bool redetected = false;
+  int windows = 1;
+  if (p_.redetection && unconfident_frames_ >= p_.lost_frames) {
+    for (const cv::Point2d& c : neighbour_windows(pos_, window_ * scale_, frame.size())) {
+      Detection candidate = detect(frame, c);
+      ++windows;
+      const double conf = confidence_of(candidate);
+      if (conf >= p_.found_confidence && conf > confidence) {
+        d = std::move(candidate);
+        confidence = conf;
+        redetected = true;
+      }
+    }
+    if (p_.global_interval > 0 && (unconfident_frames_ - p_.lost_frames) % p_.global_interval == 0) {
+      windows += p_.global_candidates;
+      redetected = search_whole_image(frame, d, confidence) || redetected;
+    }
+  }
+  const bool confident = confidence >= p_.update_confidence;
+  unconfident_frames_ = confident ? 0 : unconfident_frames_ + 1;
+
+  const cv::Point2d shift = peak_offset(d);
+  const double px_per_cell = p_.cell * window_.width * scale_ / model_.width;
+  pos_.x = std::clamp(d.centre.x + shift.x * px_per_cell, 0.0, frame.cols - 1.0);
+  pos_.y = std::clamp(d.centre.y + shift.y * px_per_cell, 0.0, frame.rows - 1.0);
+  if (confident) {
+    // The running means of the reliability follow confident frames only, so that a long loss
+    // does not lower the bar it is measured against.
+    mean_peak_ += p_.confidence_rate * (d.peak - mean_peak_);
+    mean_apce_ += p_.confidence_rate * (d.apce - mean_apce_);
+    scale_ = std::clamp(scale_ * scale_filter_.best_change(frame, pos_, scale_), p_.min_scale, p_.max_scale);
+    add_sample(d, shift);
+    if (++since_training_ >= p_.update_interval) train();
+    scale_filter_.learn(frame, pos_, scale_, p_.scale_learning_rate);
+    if (p_.hist_weight > 0)
+      colour_model_.learn(subwindow(frame, pos_, window_ * scale_, model_), target_in_model(), p_.hist_learning_rate);
+  }
+
+  TrackState s;
+  s.pose = {pos_.x, pos_.y, scale_, 0.0};
+  s.initial_size = target_;
+  s.confidence = confidence;
+  doubtful_frames_ = confidence < p_.lost_confidence ? doubtful_frames_ + 1 : 0;
+  s.lost = doubtful_frames_ >= p_.lost_after;
+  s.redetected = redetected;
+  LevelStats level;
+  level.evaluated = static_cast<int>(d.response.total()) * windows + (confident ? p_.scales : 0);
+  level.search_radius = static_cast<float>(std::min(window_.width, window_.height) * scale_ / 2);
+  s.levels.push_back(std::move(level));
+  return s;
+}
+
+}  // namespace aerie::track

@@ -1,0 +1,150 @@
+#pragma once
+// ECO: a correlation-filter tracker built, in Aerie's own code, from the ideas that make the
+// hand-crafted ECO-HC (Danelljan et al., "ECO: Efficient Convolution Operators for Tracking",
+// CVPR 2017) and the UAV-oriented filters robust:
+//
+//  * features: FHOG (31) and grey level per cell, plus colour names (11) on colour footage;
+//  * factorised convolution: each feature block is projected to a few channels by a matrix
+//    learned (PCA) on the first frame (projection.hpp);
+//  * a generative sample space: a Gaussian mixture of past samples trains the filter instead of a
+//    running average (sample_space.hpp);
+//  * sparse updates: the filter is retrained from the sample space every update_interval frames;
+//  * continuous-domain detection: the response's Fourier series is maximised by Newton's method
+//    to sub-cell precision (newton.hpp);
+//  * background suppression: the filter is constrained to the target's support while trained on
+//    every shift of a large window (BACF, Kiani Galoogahi et al. 2017; CSR-DCF's ADMM);
+//  * aberrance repression (ARCF, Huang, Fu et al. 2019): the training label mixes the ideal
+//    Gaussian with the previous response map aligned on its peak, which penalises sudden changes
+//    of the response between frames;
+//  * colour: Staple's foreground/background histogram likelihood merged with the response (as dcf);
+//  * scale: DSST's scale filter;
+//  * loss and re-detection: the state says lost while the response's peak and APCE are far below
+//    their running means; while lost, the 8 neighbouring windows are searched every frame and,
+//    every global_interval frames, the whole image at a coarse resolution (the filter as a
+//    spatial kernel over the image's feature map), the best candidates then verified at full
+//    resolution.
+//
+// Deterministic (no randomness): the seed is unused.
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "air/track/dcf/colour_histogram.hpp"
+#include "air/track/dcf/filters.hpp"
+#include "air/track/dcf/scale_filter.hpp"
+#include "air/track/eco/sample_space.hpp"
+#include "air/track/tracker.hpp"
+
+namespace aerie::track {
+
+struct EcoParams {
+  // Window and filter (as dcf).
+  int cell = 4;                      // FHOG and colour-names cell, pixels of the resized window
+  double padding = 2.0;              // window = target + padding * (w + h) / 2 per side
+  double template_area = 150 * 150;  // the window is resized to about this many pixels
+  double output_sigma = 1.0 / 16;    // Gaussian label sigma, x sqrt(target area) (in cells)
+  double lambda = 1e-3;              // filter regularisation
+  double mask_scale = 1.1;           // the filter's support is the target box times this
+  int admm_iterations = 4;
+  // Factorised convolution: channels after projection.
+  int hog_dims = 10;                 // of FHOG + grey (32)
+  int cn_dims = 3;                   // of the colour names (11), colour footage only
+  // Sample space and sparse updates (ECO-HC: 30 components, learning rate 0.009, N_s = 6).
+  int samples = 30;
+  double learning_rate = 0.01;
+  int update_interval = 6;           // frames between filter trainings
+  // ARCF: the label is (y + aberrance * M_prev) / (1 + aberrance); 0 switches it off.
+  double aberrance = 0.3;
+  int newton_iterations = 5;
+  // Staple's colour histogram merged with the response (weight 0 switches it off).
+  double hist_weight = 0.3;
+  int hist_bins = 32;
+  double hist_learning_rate = 0.04;
+  double inner_padding = 0.2;
+  // Scale filter (DSST).
+  int scales = 33;
+  double scale_step = 1.02;
+  double scale_sigma = 0.25;
+  double scale_lambda = 1e-2;
+  double scale_learning_rate = 0.025;
+  double scale_model_area = 1024;
+  double min_scale = 0.2, max_scale = 5;
+  // Loss. Confidence = min(peak, APCE) relative to their running means; below
+  // update_confidence nothing is learned. The state says lost once the confidence has stayed
+  // below lost_confidence for lost_after frames in a row (the LOST flag, measured as a
+  // detector in docs/results/track.md), until it is above again.
+  double update_confidence = 0.3;
+  double confidence_rate = 0.05;
+  double lost_confidence = 0.3;
+  int lost_after = 1;
+  // Re-detection: after lost_frames unconfident frames in a row, the 8 windows around the current
+  // one every frame, and every global_interval frames the whole image at a resolution of at most
+  // global_pixels pixels; a candidate is taken when its confidence reaches found_confidence.
+  bool redetection = true;
+  int lost_frames = 3;
+  double found_confidence = 0.7;
+  int global_interval = 5;           // 0: no whole-image search
+  double global_pixels = 320 * 240;
+  int global_candidates = 3;         // peaks of the coarse response verified at full resolution
+
+  void validate() const;  // throws std::invalid_argument naming the bad value
+  ScaleFilterParams scale_filter() const {
+    return {scales, scale_step, scale_sigma, scale_lambda, scale_model_area, cell};
+  }
+};
+
+class EcoTracker : public Tracker {
+ public:
+  explicit EcoTracker(EcoParams params, std::string name = "eco");
+  std::string name() const override { return name_; }
+  void init(const cv::Mat& frame, const cv::Rect2d& box) override;
+  TrackState update(const cv::Mat& frame) override;
+
+ private:
+  struct Detection {
+    cv::Point2d centre;          // of the window, image pixels
+    std::vector<cv::Mat> zf;     // projected, windowed feature spectra
+    cv::Mat patch;               // the window resized to the model
+    cv::Mat rf, response;        // the filter's response spectrum; its IDFT merged with the colour likelihood
+    double peak = 0, apce = 0;   // of the filter's response alone
+    cv::Point grid_peak;         // best cell of the merged response
+  };
+
+  // Raw features of an image (window patch or whole frame): one row per cell, one column per
+  // channel (FHOG + grey [+ colour names]); cells: the grid size.
+  cv::Mat raw_features(const cv::Mat& image, cv::Size& cells) const;
+  std::vector<cv::Mat> projected(const cv::Mat& raw, cv::Size cells) const;  // C maps of `cells`
+  std::vector<cv::Mat> spectra(const std::vector<cv::Mat>& maps) const;      // windowed DFTs
+  Detection detect(const cv::Mat& frame, cv::Point2d centre) const;
+  double confidence_of(const Detection& d) const;
+  cv::Point2d peak_offset(const Detection& d) const;  // sub-cell peak as a shift in cells
+  bool search_whole_image(const cv::Mat& frame, Detection& best, double& confidence) const;
+  void add_sample(const Detection& d, cv::Point2d shift_cells);
+  cv::Size2d target_in_model() const { return target_ * (model_.width / window_.width); }
+  void train();
+
+  EcoParams p_;
+  std::string name_;
+  cv::Size frame_size_;
+  bool initialised_ = false;
+  bool colour_ = false;         // colour names in use (a colour init frame)
+
+  cv::Point2d pos_;
+  cv::Size2d target_;           // initial target size, image pixels
+  double scale_ = 1;
+  cv::Size2d window_;           // window at scale 1, image pixels
+  cv::Size model_;              // resized window, pixels (cells x cell)
+  cv::Size cells_;
+  cv::Mat hann_, yf_, mask_;
+  cv::Mat hog_projection_, cn_projection_;  // D x C per block
+
+  SampleSpace samples_{1, 1, 0};
+  std::vector<cv::Mat> filter_;  // G_c per projected channel
+  ScaleFilter scale_filter_;
+  ColourHistogram colour_model_;
+
+  double mean_peak_ = 0, mean_apce_ = 0;
+  int frames_ = 0, since_training_ = 0, unconfident_frames_ = 0, doubtful_frames_ = 0;
+};
+
+}  // namespace aerie::track

@@ -1,0 +1,281 @@
+// The ECO tracker's parts against hand-computed or brute-force references (colour names,
+// the PCA projection, the Gaussian-mixture sample space, Newton's refinement of the continuous
+// response) and its own behaviour: determinism, the LOST flag while the target is out of the
+// image, the whole-image re-detection when it comes back. (The shared motion tests are in
+// test_trackers.cpp.)
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "air/track/eco/colour_names.hpp"
+#include "air/track/eco/eco.hpp"
+#include "air/track/eco/newton.hpp"
+#include "air/track/eco/projection.hpp"
+#include "air/track/eco/sample_space.hpp"
+#include "tests/air/track/synthetic.hpp"
+
+using namespace aerie::track;
+using aerie::track::test::Motion;
+using aerie::track::test::Scene;
+
+// Each focal colour is most probably its own name; every entry is a distribution; the table
+// (8-level bins) agrees with the model at the bins' centres.
+TEST(ColourNames, FocalColoursNameThemselvesAndTheTableMatchesTheModel) {
+  for (int n = 0; n < kColourNames; ++n) {
+    const auto p = colour_name_model(cv::Vec3f(focal_colours()[n][0], focal_colours()[n][1], focal_colours()[n][2]));
+    EXPECT_EQ(std::max_element(p.begin(), p.end()) - p.begin(), n);
+  }
+  cv::RNG rng(3);
+  for (int i = 0; i < 200; ++i) {
+    const cv::Vec3b c(rng.uniform(0, 256), rng.uniform(0, 256), rng.uniform(0, 256));
+    const float* t = colour_name_probabilities(c);
+    const cv::Vec3f centre((c[0] / 8) * 8 + 4.f, (c[1] / 8) * 8 + 4.f, (c[2] / 8) * 8 + 4.f);
+    const auto m = colour_name_model(centre);
+    float sum = 0;
+    for (int n = 0; n < kColourNames; ++n) {
+      sum += t[n];
+      EXPECT_NEAR(t[n], m[n], 1e-5);
+    }
+    EXPECT_NEAR(sum, 1.f, 1e-5);
+  }
+}
+
+// Per cell: the mean of the pixels' table entries, by brute force.
+TEST(ColourNames, CellMeansByBruteForce) {
+  cv::Mat img(13, 18, CV_8UC3);
+  cv::RNG(4).fill(img, cv::RNG::UNIFORM, 0, 256);
+  const auto cn = colour_names(img, 4);
+  ASSERT_EQ(cn.size(), size_t(kColourNames));
+  EXPECT_EQ(cn[0].size(), cv::Size(4, 3));
+  for (int cy = 0; cy < 3; ++cy)
+    for (int cx = 0; cx < 4; ++cx)
+      for (int n = 0; n < kColourNames; ++n) {
+        double mean = 0;
+        for (int y = 4 * cy; y < 4 * cy + 4; ++y)
+          for (int x = 4 * cx; x < 4 * cx + 4; ++x) mean += colour_name_probabilities(img.at<cv::Vec3b>(y, x))[n] / 16;
+        EXPECT_NEAR(cn[n].at<float>(cy, cx), mean, 1e-6);
+      }
+  EXPECT_THROW(colour_names(cv::Mat(8, 8, CV_8U), 4), std::invalid_argument);
+  EXPECT_THROW(colour_names(img, 0), std::invalid_argument);
+  EXPECT_THROW(colour_names(img(cv::Rect(0, 0, 3, 3)), 4), std::invalid_argument);
+}
+
+// Cells spread over a plane of a 5-D space: the 2 leading directions are orthonormal and span
+// it (the projection keeps each cell's offset from the mean exactly); a third has no variance.
+TEST(Projection, PcaFindsTheSubspaceOfTheCells) {
+  const cv::Mat a = (cv::Mat_<float>(5, 1) << 1, 2, 0, -1, 0.5), b = (cv::Mat_<float>(5, 1) << 0, 1, 3, 1, -2);
+  const cv::Mat offset = (cv::Mat_<float>(5, 1) << 4, -1, 2, 0, 1);
+  cv::Mat x(5, 200, CV_32F);
+  cv::RNG rng(7);
+  for (int i = 0; i < x.cols; ++i) {
+    const cv::Mat col = offset + rng.gaussian(3) * a + rng.gaussian(1) * b;
+    col.copyTo(x.col(i));
+  }
+  const cv::Mat P = pca_projection(x, 2);
+  ASSERT_EQ(P.size(), cv::Size(2, 5));
+  EXPECT_LT(cv::norm(P.t() * P, cv::Mat::eye(2, 2, CV_32F), cv::NORM_INF), 1e-5);
+  cv::Mat mean;
+  cv::reduce(x, mean, 1, cv::REDUCE_AVG);
+  for (int i = 0; i < x.cols; i += 37) {
+    const cv::Mat d = x.col(i) - mean;
+    EXPECT_LT(cv::norm(P * (P.t() * d), d, cv::NORM_INF), 1e-3 * cv::norm(d, cv::NORM_INF));
+  }
+  const cv::Mat y = project(x, P);
+  ASSERT_EQ(y.size(), cv::Size(200, 2));
+  EXPECT_LT(cv::norm(y.col(5), P.t() * x.col(5), cv::NORM_INF), 1e-4);
+  const cv::Mat P3 = pca_projection(x, 3);
+  cv::Mat third = P3.col(2).t() * (x - cv::repeat(mean, 1, x.cols));
+  EXPECT_LT(cv::norm(third, cv::NORM_INF), 1e-3);
+  EXPECT_THROW(pca_projection(x, 6), std::invalid_argument);
+  EXPECT_THROW(pca_projection(x, 0), std::invalid_argument);
+}
+
+namespace {
+Sample constant_sample(float v) {
+  Sample s;
+  s.xf = {cv::Mat(2, 2, CV_32FC2, cv::Scalar(v, 0))};
+  s.yf = cv::Mat(2, 2, CV_32FC2, cv::Scalar(v, 1));
+  return s;
+}
+float value(const Sample& s) { return s.xf[0].at<cv::Vec2f>(0, 0)[0]; }
+}  // namespace
+
+// Capacity 2, learning rate 0.5, by hand:
+//  add 0  -> {0: w 1}
+//  add 10 -> {0: 0.5, 10: 0.5}
+//  add 9  -> 9 is nearer to 10 (d = 4) than 0 is to 10 (d = 400): merged into it,
+//            weights 0.25 and 0.25 + 0.5, mean (0.25 * 10 + 0.5 * 9) / 0.75 = 9.333
+//  add -30 -> the two components (d = 4 * 9.333^2 = 348) are nearer than -30 is to 0 (3600):
+//            they merge into one of weight 0.5 (mean 7) and -30 takes the freed slot (0.5).
+TEST(SampleSpace, MergesTheNearestAsEcoDoesByHand) {
+  SampleSpace space(2, 0.5, 0.0);
+  space.add(constant_sample(0));
+  ASSERT_EQ(space.components().size(), 1u);
+  EXPECT_DOUBLE_EQ(space.weights()[0], 1.0);
+  space.add(constant_sample(10));
+  ASSERT_EQ(space.components().size(), 2u);
+  EXPECT_DOUBLE_EQ(space.weights()[1], 0.5);
+  space.add(constant_sample(9));
+  EXPECT_DOUBLE_EQ(space.weights()[0], 0.25);
+  EXPECT_DOUBLE_EQ(space.weights()[1], 0.75);
+  EXPECT_NEAR(value(space.components()[1]), 28.0 / 3, 1e-5);
+  EXPECT_NEAR(space.components()[1].yf.at<cv::Vec2f>(0, 0)[0], 28.0 / 3, 1e-5);  // labels merge too
+  EXPECT_NEAR(SampleSpace::distance(space.components()[0], space.components()[1]), 4 * (28.0 / 3) * (28.0 / 3), 1e-4);
+  space.add(constant_sample(-30));
+  ASSERT_EQ(space.components().size(), 2u);
+  EXPECT_NEAR(value(space.components()[0]), 7.0, 1e-5);
+  EXPECT_DOUBLE_EQ(space.weights()[0], 0.5);
+  EXPECT_EQ(value(space.components()[1]), -30.f);
+  EXPECT_DOUBLE_EQ(space.weights()[1], 0.5);
+  EXPECT_THROW(SampleSpace(0, 0.1, 0), std::invalid_argument);
+  EXPECT_THROW(SampleSpace(3, 0, 0), std::invalid_argument);
+}
+
+// A component lighter than min_weight is replaced outright.
+TEST(SampleSpace, ReplacesAForgottenComponent) {
+  SampleSpace space(2, 0.5, 0.2);
+  space.add(constant_sample(0));
+  space.add(constant_sample(10));   // weights 0.5, 0.5
+  space.add(constant_sample(9));    // 0.25 is not below 0.2: merged, 0.25 and 0.75
+  space.add(constant_sample(100));  // 0.125 < 0.2: replaced by 100 at 0.5, beside 0.375
+  EXPECT_EQ(value(space.components()[0]), 100.f);
+  EXPECT_NEAR(space.weights()[0], 0.5 / 0.875, 1e-12);
+  EXPECT_NEAR(value(space.components()[1]), 28.0 / 3, 1e-5);
+}
+
+// s(x, y) = 3 cos(2 pi (x - x0) / W) + cos(4 pi (y - y0) / H) + 2 cos(2 pi (y - y0) / H) is a
+// trigonometric polynomial that the grid's DFT represents exactly; its maximum is (x0, y0),
+// between grid points. Newton's method from the best grid point reaches it; the grid alone is
+// up to half a cell off.
+TEST(Newton, ReachesTheSubCellMaximumOfTheContinuousResponse) {
+  const int w = 24, h = 18;
+  const double x0 = 7.37, y0 = 11.71;
+  cv::Mat s(h, w, CV_32F);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      s.at<float>(y, x) = static_cast<float>(3 * std::cos(2 * CV_PI * (x - x0) / w) +
+                                             std::cos(4 * CV_PI * (y - y0) / h) + 2 * std::cos(2 * CV_PI * (y - y0) / h));
+  cv::Mat sf;
+  cv::dft(s, sf, cv::DFT_COMPLEX_OUTPUT);
+  const ResponseValue at_grid = response_at(sf, {3, 4});
+  EXPECT_NEAR(at_grid.s, s.at<float>(4, 3), 1e-4);
+  cv::Point best;
+  cv::minMaxLoc(s, nullptr, nullptr, nullptr, &best);
+  EXPECT_EQ(best, cv::Point(7, 12));
+  const cv::Point2d p = newton_peak(sf, best, 5);
+  EXPECT_NEAR(p.x, x0, 1e-3);
+  EXPECT_NEAR(p.y, y0, 1e-3);
+  const ResponseValue top = response_at(sf, p);
+  EXPECT_NEAR(top.dx, 0, 1e-4);
+  EXPECT_NEAR(top.dy, 0, 1e-4);
+  EXPECT_NEAR(top.s, 6.0, 1e-4);
+  EXPECT_EQ(newton_peak(sf, best, 0), cv::Point2d(best));
+}
+
+namespace {
+
+// The target moves right at 2 px per frame; from frame `out` to `back` it is outside the image
+// (far beyond the right border), then it reappears at `reappear`.
+struct ExitScene {
+  Scene scene{{320, 240}, {36, 30}, 11};
+  int out = 15, back = 40;
+  cv::Point2d reappear{230, 150};
+  Motion at(int i) const {
+    Motion m;
+    m.centre = {90 + 2.0 * i, 100};
+    if (i >= out && i < back) m.centre = {1000, 1000};
+    if (i >= back) m.centre = reappear + cv::Point2d(i - back, 0);
+    return m;
+  }
+};
+
+}  // namespace
+
+// On the frame it learned from, the response peaks at zero shift: the box stays.
+TEST(Eco, TheTrainingFrameGivesTheSameBox) {
+  const Scene scene({240, 180}, {40, 32});
+  Motion m;
+  m.centre = {100.3, 80.6};
+  EcoTracker t(EcoParams{});
+  t.init(scene.render(m), scene.box(m));
+  const TrackState s = t.update(scene.render(m));
+  EXPECT_NEAR(s.pose.x, m.centre.x, 0.25);
+  EXPECT_NEAR(s.pose.y, m.centre.y, 0.25);
+  EXPECT_DOUBLE_EQ(s.pose.scale, 1.0);
+  EXPECT_NEAR(s.confidence, 1.0, 1e-9);
+  EXPECT_FALSE(s.lost);
+}
+
+// The LOST flag rises within 5 frames of the target leaving the image, and stays down while it
+// is tracked; when it comes back elsewhere, the whole-image search finds it again.
+TEST(Eco, LostWhileOutOfViewAndFoundAgain) {
+  const ExitScene e;
+  EcoTracker t(EcoParams{});
+  t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
+  int first_lost = -1, false_alarms = 0, redetected_at = -1;
+  double final_error = 0;
+  for (int i = 1; i < 70; ++i) {
+    const Motion m = e.at(i);
+    const TrackState s = t.update(e.scene.render(m));
+    const bool out = i >= e.out && i < e.back;
+    if (!out && i < e.out) false_alarms += s.lost;
+    if (out && s.lost && first_lost < 0) first_lost = i;
+    if (i >= e.back && s.redetected && redetected_at < 0) redetected_at = i;
+    final_error = std::hypot(s.pose.x - m.centre.x, s.pose.y - m.centre.y);
+  }
+  EXPECT_EQ(false_alarms, 0);
+  ASSERT_GE(first_lost, e.out);
+  EXPECT_LT(first_lost, e.out + 5);
+  ASSERT_GE(redetected_at, e.back);
+  EXPECT_LE(redetected_at, e.back + EcoParams{}.global_interval + 1);
+  EXPECT_LT(final_error, 4.0);
+}
+
+// Without the whole-image search, only the 8 neighbouring windows are searched: the target,
+// back far from where it was lost, is not found.
+TEST(Eco, WithoutTheWholeImageSearchTheFarTargetStaysLost) {
+  const ExitScene e;
+  EcoParams p;
+  p.global_interval = 0;
+  EcoTracker t(p);
+  t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
+  TrackState s;
+  for (int i = 1; i < 70; ++i) s = t.update(e.scene.render(e.at(i)));
+  EXPECT_TRUE(s.lost);
+  EXPECT_GT(std::hypot(s.pose.x - e.at(69).centre.x, s.pose.y - e.at(69).centre.y), 50.0);
+}
+
+TEST(Eco, SameInputSameTrack) {
+  const ExitScene e;
+  auto run = [&] {
+    EcoTracker t(EcoParams{});
+    t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
+    std::vector<double> out;
+    for (int i = 1; i < 50; ++i) {
+      const TrackState s = t.update(e.scene.render(e.at(i)));
+      out.insert(out.end(), {s.pose.x, s.pose.y, s.pose.scale, s.confidence});
+    }
+    return out;
+  };
+  EXPECT_EQ(run(), run());
+}
+
+TEST(Eco, BadParametersAreNamed) {
+  auto message = [](auto change) {
+    EcoParams p;
+    change(p);
+    try {
+      EcoTracker t(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message([](EcoParams& p) { p.hog_dims = 40; }).find("hog_dims"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.cn_dims = -1; }).find("cn_dims"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.update_interval = 0; }).find("update_interval"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.aberrance = NAN; }).find("aberrance"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.learning_rate = 0; }).find("learning rates"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.global_pixels = 10; }).find("global_pixels"), std::string::npos);
+  EXPECT_EQ(message([](EcoParams&) {}), "accepted");
+}
