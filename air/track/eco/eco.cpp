@@ -92,7 +92,9 @@ cv::Mat EcoTracker::raw_features(const cv::Mat& image, cv::Size& cells) const {
   cv::resize(to_gray(whole), grey, cells, 0, 0, cv::INTER_AREA);
   grey.convertTo(raw.row(kFhogChannels).reshape(1, cells.height), CV_32F, 1.0 / 255, -0.5);
   if (colour_) {
-    const std::vector<cv::Mat> cn = colour_names(whole, p_.cell);
+    cv::Mat mean_colour;  // the colour names of each cell's mean colour (one lookup per cell)
+    cv::resize(whole, mean_colour, cells, 0, 0, cv::INTER_AREA);
+    const std::vector<cv::Mat> cn = colour_names(mean_colour, 1);
     for (int c = 0; c < kColourNames; ++c) cn[c].reshape(1, 1).copyTo(raw.row(kHogBlock + c));
   }
   return raw;

@@ -75,8 +75,8 @@ struct EcoParams {
   // detector in docs/results/track.md), until it is above again.
   double update_confidence = 0.3;
   double confidence_rate = 0.05;
-  double lost_confidence = 0.3;
-  int lost_after = 1;
+  double lost_confidence = 0.15;  // chosen on simulated exits (bench/track/lost_rule.py)
+  int lost_after = 3;
   // Re-detection: after lost_frames unconfident frames in a row, the 8 windows around the current
   // one every frame, and every global_interval frames the whole image at a resolution of at most
   // global_pixels pixels; a candidate is taken when its confidence reaches found_confidence.

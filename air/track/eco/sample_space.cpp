@@ -13,9 +13,18 @@ SampleSpace::SampleSpace(int capacity, double learning_rate, double min_weight)
   distance_ = cv::Mat(capacity, capacity, CV_64F, cv::Scalar(0));
 }
 
+// The spectra are of real signals (Hermitian: X[-k] = conj X[k]), so the columns right of the
+// middle repeat those left of it: twice the left half, less the columns that are their own
+// mirror (0 and, for an even width, W / 2).
 double SampleSpace::distance(const Sample& a, const Sample& b) {
   double d = 0;
-  for (size_t c = 0; c < a.xf.size(); ++c) d += cv::norm(a.xf[c], b.xf[c], cv::NORM_L2SQR);
+  for (size_t c = 0; c < a.xf.size(); ++c) {
+    const int w = a.xf[c].cols, half = w / 2 + 1;
+    auto cols = [&](int from, int to) {
+      return cv::norm(a.xf[c].colRange(from, to), b.xf[c].colRange(from, to), cv::NORM_L2SQR);
+    };
+    d += 2 * cols(0, half) - cols(0, 1) - (w % 2 == 0 && w > 1 ? cols(w / 2, w / 2 + 1) : 0.0);
+  }
   return d;
 }
 

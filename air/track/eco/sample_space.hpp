@@ -24,7 +24,8 @@ class SampleSpace {
   void add(const Sample& s);
   const std::vector<Sample>& components() const { return components_; }
   const std::vector<double>& weights() const { return weights_; }
-  // Squared Euclidean distance of two samples' feature spectra (summed over channels).
+  // Squared Euclidean distance of two samples' feature spectra (summed over channels), which
+  // must be DFTs of real signals.
   static double distance(const Sample& a, const Sample& b);
 
  private:

@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   double target_size = -1;
   app.add_option("--camera", camera, "camera channel (default from the config, else CAM_LEFT)");
   app.add_flag("--stereo", stereo, "the camera channel carries stereo pairs (CAM_STEREO): track the left image");
-  app.add_option("--tracker", tracker, "tracker for INIT commands that name none: ipsl, ipsl-mr, ct, amcmr-ct, mil, am3, dcf (default amcmr-ct)");
+  app.add_option("--tracker", tracker, "tracker for INIT commands that name none: ipsl, ipsl-mr, ct, amcmr-ct, mil, am3, dcf, eco, opencv-* (default eco)");
   app.add_option("--init-from-gt", init_from_gt,
                  "initialise on the GT_TRACK box after this many frames (simulation demo, no operator)");
   app.add_option("--target-size", target_size, "target width = height in metres (enables TARGET_POSE)");

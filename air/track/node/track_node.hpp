@@ -48,7 +48,7 @@ struct NodeOptions {
   std::string track_channel = "TRACK";
   std::string pose_channel = "TARGET_POSE";
   std::string gt_channel = "GT_TRACK";
-  std::string tracker = "amcmr-ct";  // used by INIT commands that name none
+  std::string tracker = "eco";  // used by INIT commands that name none
   uint64_t seed = 1;
   util::Config trackers;  // per-tracker parameter sections (track.yaml "trackers:")
   int max_points = 200;   // sample positions per level published for display

@@ -206,7 +206,7 @@ TEST_F(NodeTest, BadMessagesAndCommandsAreCountedNotFatal) {
   node.report(status);
   EXPECT_EQ(status.counter("command_errors"), 3);
   // still alive: a good INIT tracks, STOP returns to IDLE
-  send_init(scene_.box(motion(3)));
+  send_init(scene_.box(motion(3)), "amcmr-ct");
   bus_.publish("CAM_LEFT", frame(3));
   settle(node);
   bus_.publish("CAM_LEFT", frame(4));
@@ -339,7 +339,7 @@ TEST_F(NodeTest, AFrameOfAnotherSizeEndsTheTrackWithAReason) {
   aerie::bus::StatusReporter status(bus_, "track");
   bus_.publish("CAM_LEFT", frame(0));
   settle(node);
-  send_init(scene_.box(motion(0)));
+  send_init(scene_.box(motion(0)), "amcmr-ct");
   bus_.publish("CAM_LEFT", frame(1));
   settle(node);
   ASSERT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
@@ -354,7 +354,7 @@ TEST_F(NodeTest, AFrameOfAnotherSizeEndsTheTrackWithAReason) {
   EXPECT_NE(status.message().find("frame size changed from 240x180 to 120x90; track of amcmr-ct ended"),
             std::string::npos) << status.message();
   // A new INIT on the new size tracks again.
-  send_init({40, 40, 20, 16});
+  send_init({40, 40, 20, 16}, "amcmr-ct");
   bus_.publish("CAM_LEFT", aerie::image::to_message(small, 2'100'000, 3));
   settle(node);
   bus_.publish("CAM_LEFT", aerie::image::to_message(small, 2'200'000, 4));
@@ -441,5 +441,21 @@ TEST_F(NodeTest, ACameraOutageIsReportedAndTrackingGoesOnAfterIt) {
   send(14, 25'000'000);
   for (const auto& t : tracks_) EXPECT_NE(t.utime, std::numeric_limits<int64_t>::max());
   EXPECT_EQ(status.counter("CAM_LEFT.time_jumps"), 3);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+}
+
+// The default tracker (an INIT that names none) is eco, the accurate tracker that runs at
+// air-side speed (docs/track.md "Which to fly").
+TEST_F(NodeTest, TheDefaultTrackerIsEco) {
+  TrackNode node(bus_, NodeOptions{});
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  send_init(scene_.box(motion(0)), "", false);
+  for (int i = 1; i <= 3; ++i) {
+    bus_.publish("CAM_LEFT", frame(i));
+    settle(node);
+  }
+  ASSERT_FALSE(tracks_.empty());
+  EXPECT_EQ(tracks_.back().tracker, "eco");
   EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
 }
