@@ -295,13 +295,18 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   }
   double confidence = confidence_of(d);
 
-  // Re-detection while lost: the 8 neighbouring windows (3/4 of a window apart) every frame,
-  // the whole image every global_interval frames.
+  // Re-detection while lost, within a budget of 5 window detections per frame: half of the 8
+  // neighbouring windows (3/4 of a window apart) in turn, the 4 sides and then the 4 corners;
+  // every global_interval frames also the whole image (about 6 more).
   bool redetected = false;
   int windows = 1;
   if (p_.redetection && unconfident_frames_ >= p_.lost_frames) {
-    for (const cv::Point2d& c : neighbour_windows(pos_, window_ * scale_, frame.size())) {
-      Detection candidate = detect(frame, c);
+    const std::vector<cv::Point2d> around = neighbour_windows(pos_, window_ * scale_, frame.size());
+    const bool corners = (unconfident_frames_ - p_.lost_frames) % 2 == 1;
+    for (size_t k = 0; k < around.size(); ++k) {
+      const bool corner = k == 0 || k == 2 || k == 5 || k == 7;  // neighbour_windows' row-major order
+      if (corner != corners) continue;
+      Detection candidate = detect(frame, around[k]);
       ++windows;
       const double conf = confidence_of(candidate);
       if (conf >= p_.found_confidence && conf > confidence) {

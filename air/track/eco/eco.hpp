@@ -18,8 +18,9 @@
 //    of the response between frames;
 //  * colour: Staple's foreground/background histogram likelihood merged with the response (as dcf);
 //  * scale: DSST's scale filter;
-//  * loss and re-detection: the state says lost while the response's peak and APCE are far below
-//    their running means; while lost, the 8 neighbouring windows are searched every frame and,
+//  * loss and re-detection: the state says lost once the response's peak or APCE has stayed far
+//    below its running mean for a few frames; while lost, the 8 neighbouring windows are searched
+//    every frame and,
 //    every global_interval frames, the whole image at a coarse resolution (the filter as a
 //    spatial kernel over the image's feature map), the best candidates then verified at full
 //    resolution.
@@ -110,8 +111,8 @@ class EcoTracker : public Tracker {
     cv::Point grid_peak;         // best cell of the merged response
   };
 
-  // Raw features of an image (window patch or whole frame): one row per cell, one column per
-  // channel (FHOG + grey [+ colour names]); cells: the grid size.
+  // Raw features of an image (window patch or whole frame): one row per channel (FHOG + grey
+  // [+ colour names]), one column per cell; cells: the grid size.
   cv::Mat raw_features(const cv::Mat& image, cv::Size& cells) const;
   std::vector<cv::Mat> projected(const cv::Mat& raw, cv::Size cells) const;  // C maps of `cells`
   std::vector<cv::Mat> spectra(const std::vector<cv::Mat>& maps) const;      // windowed DFTs
