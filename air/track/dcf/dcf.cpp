@@ -76,17 +76,17 @@ cv::Mat stack_rows(const std::vector<cv::Mat>& spectra) {
 DcfTracker::DcfTracker(DcfParams params, std::string name) : p_(params), name_(std::move(name)) { p_.validate(); }
 
 cv::Mat DcfTracker::window_patch(const cv::Mat& frame, cv::Point2d centre) const {
-  return subwindow(frame, centre, window_ * scale_, model_);
+  return subwindow(frame, centre, fw_.window * scale_, fw_.model);
 }
 
 DcfTracker::Spectrum DcfTracker::translation_features(const cv::Mat& patch) const {
   std::vector<cv::Mat> channels = fhog(patch, p_.cell);
   cv::Mat gray;  // mean grey level per cell, centred
-  cv::resize(to_gray(patch), gray, hann_.size(), 0, 0, cv::INTER_AREA);
+  cv::resize(to_gray(patch), gray, fw_.hann.size(), 0, 0, cv::INTER_AREA);
   gray.convertTo(gray, CV_32F, 1.0 / 255, -0.5);
   channels.push_back(gray);
   Spectrum xf(channels.size());
-  for (size_t c = 0; c < channels.size(); ++c) cv::dft(channels[c].mul(hann_), xf[c], cv::DFT_COMPLEX_OUTPUT);
+  for (size_t c = 0; c < channels.size(); ++c) cv::dft(channels[c].mul(fw_.hann), xf[c], cv::DFT_COMPLEX_OUTPUT);
   return xf;
 }
 
@@ -97,17 +97,17 @@ void DcfTracker::learn(const cv::Mat& frame, bool first) {
   learn_translation(translation_features(patch), first ? 1.0 : p_.learning_rate);
   scale_filter_.learn(frame, pos_, scale_, first ? 1.0 : p_.scale_learning_rate);
   if (p_.hist_weight > 0)
-    colour_.learn(patch, target_ * (model_.width / window_.width), first ? 1.0 : p_.hist_learning_rate);
+    colour_.learn(patch, target_ * (fw_.model.width / fw_.window.width), first ? 1.0 : p_.hist_learning_rate);
 }
 
 void DcfTracker::learn_translation(const Spectrum& xf, double rate) {
   if (p_.spatial_mask) {
     Spectrum g(xf.size());
-    for (size_t c = 0; c < xf.size(); ++c) g[c] = masked_filter(xf[c], yf_, mask_, p_);
+    for (size_t c = 0; c < xf.size(); ++c) g[c] = masked_filter(xf[c], fw_.yf, fw_.mask, p_);
     blend(filter_, g, rate);
     return;
   }
-  linear_.learn(stack_rows(xf), yf_.reshape(0, 1), rate);
+  linear_.learn(stack_rows(xf), fw_.yf.reshape(0, 1), rate);
 }
 
 void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
@@ -119,12 +119,7 @@ void DcfTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   frames_ = 0;
   unconfident_frames_ = 0;
 
-  const FilterWindow w = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
-  model_ = w.model;
-  window_ = w.window;
-  hann_ = w.hann;
-  mask_ = w.mask;
-  yf_ = w.yf;
+  fw_ = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
 
   scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
   colour_ = ColourHistogram(p_.hist_bins, p_.inner_padding);
@@ -162,7 +157,7 @@ DcfTracker::Detection DcfTracker::detect(const cv::Mat& frame, cv::Point2d centr
 
   // Staple: merge with the mean colour likelihood of a target-sized box at each shift.
   if (p_.hist_weight > 0)
-    colour_.merge(d.response, patch, target_ * (model_.width / window_.width), p_.cell, p_.hist_weight);
+    colour_.merge(d.response, patch, target_ * (fw_.model.width / fw_.window.width), p_.cell, p_.hist_weight);
   return d;
 }
 
@@ -178,7 +173,7 @@ cv::Point2d DcfTracker::peak_location(const Detection& d) const {
       circular(at.y, cells.height) + refine(value(at.y - 1, at.x), value(at.y, at.x), value(at.y + 1, at.x));
   const double dx =
       circular(at.x, cells.width) + refine(value(at.y, at.x - 1), value(at.y, at.x), value(at.y, at.x + 1));
-  const double px_per_cell = p_.cell * window_.width * scale_ / model_.width;
+  const double px_per_cell = p_.cell * fw_.window.width * scale_ / fw_.model.width;
   return d.centre + cv::Point2d(dx, dy) * px_per_cell;
 }
 
@@ -204,7 +199,7 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   bool redetected = false;
   int windows = 1;
   if (p_.redetection && unconfident_frames_ >= p_.lost_frames) {
-    for (const cv::Point2d& c : neighbour_windows(pos_, window_ * scale_, frame.size())) {
+    for (const cv::Point2d& c : neighbour_windows(pos_, fw_.window * scale_, frame.size())) {
       Detection candidate = detect(frame, c);
       ++windows;
       const double conf = confidence_of(candidate);
@@ -234,7 +229,7 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
   s.redetected = redetected;
   LevelStats level;
   level.evaluated = static_cast<int>(d.response.total()) * windows + p_.scales;
-  level.search_radius = static_cast<float>(std::min(window_.width, window_.height) * scale_ / 2);
+  level.search_radius = static_cast<float>(std::min(fw_.window.width, fw_.window.height) * scale_ / 2);
   s.levels.push_back(std::move(level));
   return s;
 }

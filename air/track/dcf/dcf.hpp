@@ -22,6 +22,7 @@
 #include "air/track/dcf/colour_histogram.hpp"
 #include "air/track/dcf/filters.hpp"
 #include "air/track/dcf/scale_filter.hpp"
+#include "air/track/dcf/window.hpp"
 #include "air/track/tracker.hpp"
 
 namespace aerie::track {
@@ -110,13 +111,9 @@ class DcfTracker : public Tracker {
   cv::Point2d pos_;
   cv::Size2d target_;    // initial target size, image pixels
   double scale_ = 1;     // current size / initial size
-  cv::Size2d window_;    // window at scale 1, image pixels
-  cv::Size model_;       // resized window, pixels (cells x cell)
-  cv::Mat hann_;         // cells
-  cv::Mat yf_;           // label spectrum
+  FilterWindow fw_;      // window at scale 1, model size, taper, support (mask), label spectrum
   LinearFilter linear_;  // !spatial_mask: the unconstrained filter
   Spectrum filter_;      // spatial_mask: G_c per channel, running
-  cv::Mat mask_;         // cells, 1 inside the target box
 
   ScaleFilter scale_filter_;
 

@@ -113,7 +113,7 @@ std::vector<cv::Mat> EcoTracker::projected(const cv::Mat& raw, cv::Size cells) c
 
 std::vector<cv::Mat> EcoTracker::spectra(const std::vector<cv::Mat>& maps) const {
   std::vector<cv::Mat> xf(maps.size());
-  for (size_t c = 0; c < maps.size(); ++c) cv::dft(maps[c].mul(hann_), xf[c], cv::DFT_COMPLEX_OUTPUT);
+  for (size_t c = 0; c < maps.size(); ++c) cv::dft(maps[c].mul(fw_.hann), xf[c], cv::DFT_COMPLEX_OUTPUT);
   return xf;
 }
 
@@ -121,10 +121,10 @@ EcoTracker::Detection EcoTracker::detect(const cv::Mat& frame, cv::Point2d centr
   Detection d;
   d.centre = centre;
   cv::Size cells;
-  d.patch = subwindow(frame, centre, window_ * scale_, model_);
+  d.patch = subwindow(frame, centre, fw_.window * scale_, fw_.model);
   d.zf = spectra(projected(raw_features(d.patch, cells), cells));
   // Response spectrum sum_c G_c Z_c (the filters' convention: G = Y conj(X) / |X|^2).
-  d.rf = cv::Mat(cells_, CV_32FC2, cv::Scalar::all(0));
+  d.rf = cv::Mat(fw_.cells, CV_32FC2, cv::Scalar::all(0));
   Complex* out = d.rf.ptr<Complex>();
   for (size_t c = 0; c < d.zf.size(); ++c) {
     const Complex* z = d.zf[c].ptr<Complex>();
@@ -149,7 +149,7 @@ cv::Point2d EcoTracker::peak_offset(const Detection& d) const {
   const cv::Point2d grid(d.grid_peak);
   const cv::Point2d peak = newton_peak(d.rf, grid, p_.newton_iterations);
   const cv::Point2d moved = peak - grid;  // Newton's refinement: within a cell or two of the grid peak
-  return {circular(d.grid_peak.x, cells_.width) + moved.x, circular(d.grid_peak.y, cells_.height) + moved.y};
+  return {circular(d.grid_peak.x, fw_.cells.width) + moved.x, circular(d.grid_peak.y, fw_.cells.height) + moved.y};
 }
 
 void EcoTracker::add_sample(const Detection& d, cv::Point2d shift) {
@@ -158,7 +158,7 @@ void EcoTracker::add_sample(const Detection& d, cv::Point2d shift) {
   // ARCF: this frame's response (the filter before this update), aligned on its peak, scaled to
   // peak 1, mixed into the label: the new filter is kept from changing the response abruptly.
   const cv::Mat aligned = shifted(d.rf, -shift) / std::max(d.peak, 1e-12);
-  s.yf = p_.aberrance > 0 ? (yf_ + p_.aberrance * aligned) / (1 + p_.aberrance) : yf_;
+  s.yf = p_.aberrance > 0 ? (fw_.yf + p_.aberrance * aligned) / (1 + p_.aberrance) : fw_.yf;
   samples_.add(s);
 }
 
@@ -167,11 +167,11 @@ void EcoTracker::add_sample(const Detection& d, cv::Point2d shift) {
 void EcoTracker::train() {
   const auto& comps = samples_.components();
   const auto& w = samples_.weights();
-  const size_t channels = comps[0].xf.size(), n = static_cast<size_t>(cells_.area());
+  const size_t channels = comps[0].xf.size(), n = static_cast<size_t>(fw_.cells.area());
   filter_.resize(channels);
   const AdmmSettings admm{p_.lambda, p_.admm_iterations, 5, 3, 20};
   for (size_t c = 0; c < channels; ++c) {
-    cv::Mat yx(cells_, CV_32FC2, cv::Scalar::all(0)), sxx(cells_, CV_32F, cv::Scalar(0));
+    cv::Mat yx(fw_.cells, CV_32FC2, cv::Scalar::all(0)), sxx(fw_.cells, CV_32F, cv::Scalar(0));
     Complex* a = yx.ptr<Complex>();
     float* e = sxx.ptr<float>();
     for (size_t m = 0; m < comps.size(); ++m) {
@@ -183,7 +183,7 @@ void EcoTracker::train() {
         e[k] += wm * std::norm(x[k]);
       }
     }
-    filter_[c] = masked_filter(yx, sxx, mask_, admm);
+    filter_[c] = masked_filter(yx, sxx, fw_.mask, admm);
   }
   since_training_ = 0;
 }
@@ -198,36 +198,30 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   const cv::Rect inside = cv::Rect(box) & cv::Rect(0, 0, frame.cols, frame.rows);
   colour_ = p_.cn_dims > 0 && has_colour(frame, inside.empty() ? cv::Rect(0, 0, frame.cols, frame.rows) : inside);
 
-  const FilterWindow w = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
-  cells_ = w.cells;
-  model_ = w.model;
-  window_ = w.window;
-  hann_ = w.hann;
-  mask_ = w.mask;
-  yf_ = w.yf;
+  fw_ = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
 
   // Factorised convolution: each block's projection from the first window's cells (PCA).
   cv::Size cells;
-  const cv::Mat raw = raw_features(subwindow(frame, pos_, window_, model_), cells);
+  const cv::Mat raw = raw_features(subwindow(frame, pos_, fw_.window, fw_.model), cells);
   hog_projection_ = pca_projection(raw.rowRange(0, kHogBlock), p_.hog_dims);
   cn_projection_ = colour_ ? pca_projection(raw.rowRange(kHogBlock, raw.rows), p_.cn_dims) : cv::Mat();
 
   // ECO's minimum weight: a sample older than twice the capacity at the learning rate.
   samples_ = SampleSpace(p_.samples, p_.learning_rate,
                          p_.learning_rate * std::pow(1 - p_.learning_rate, 2.0 * p_.samples));
-  samples_.add({spectra(projected(raw, cells)), yf_});
+  samples_.add({spectra(projected(raw, cells)), fw_.yf});
   train();
   scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
   scale_filter_.learn(frame, pos_, scale_, 1.0);
   colour_model_ = ColourHistogram(p_.hist_bins, p_.inner_padding);
-  if (p_.hist_weight > 0) colour_model_.learn(subwindow(frame, pos_, window_, model_), target_in_model(), 1.0);
+  if (p_.hist_weight > 0) colour_model_.learn(subwindow(frame, pos_, fw_.window, fw_.model), target_in_model(), 1.0);
   initialised_ = true;
 }
 
 bool EcoTracker::search_whole_image(const cv::Mat& frame, Detection& best, double& confidence) const {
   // The frame at the filter's resolution (model pixels per image pixel), reduced to at most
   // global_pixels pixels: the coarse level.
-  const double r = model_.width / (window_.width * scale_);
+  const double r = fw_.model.width / (fw_.window.width * scale_);
   const double q = std::min(1.0, std::sqrt(p_.global_pixels / (frame.total() * r * r)));
   const cv::Size size(cvRound(frame.cols * r * q), cvRound(frame.rows * r * q));
   if (size.width < 4 * p_.cell || size.height < 4 * p_.cell) return false;
@@ -238,9 +232,9 @@ bool EcoTracker::search_whole_image(const cv::Mat& frame, Detection& best, doubl
 
   // The filter as a spatial kernel around the window's centre cell c0: a target at cell p of the
   // map scores sum_u g(c0 + u) F(p - u) (the window's circular convolution), resized by q.
-  const cv::Point c0(cells_.width / 2, cells_.height / 2);
-  const int rx = std::min(cells_.width / 2, static_cast<int>(std::ceil(target_.width * scale_ * r / p_.cell / 2)) + 1);
-  const int ry = std::min(cells_.height / 2, static_cast<int>(std::ceil(target_.height * scale_ * r / p_.cell / 2)) + 1);
+  const cv::Point c0(fw_.cells.width / 2, fw_.cells.height / 2);
+  const int rx = std::min(fw_.cells.width / 2, static_cast<int>(std::ceil(target_.width * scale_ * r / p_.cell / 2)) + 1);
+  const int ry = std::min(fw_.cells.height / 2, static_cast<int>(std::ceil(target_.height * scale_ * r / p_.cell / 2)) + 1);
   cv::Mat score(cells, CV_32F, cv::Scalar(0));
   for (size_t c = 0; c < maps.size(); ++c) {
     cv::Mat g;
@@ -249,7 +243,7 @@ bool EcoTracker::search_whole_image(const cv::Mat& frame, Detection& best, doubl
     for (int v = -ry; v <= ry; ++v)  // flipped for filter2D's correlation: k(v) = g(c0 - v)
       for (int u = -rx; u <= rx; ++u)
         k.at<float>(v + ry, u + rx) =
-            g.at<float>((c0.y - v + cells_.height) % cells_.height, (c0.x - u + cells_.width) % cells_.width);
+            g.at<float>((c0.y - v + fw_.cells.height) % fw_.cells.height, (c0.x - u + fw_.cells.width) % fw_.cells.width);
     if (q < 1) cv::resize(k, k, cv::Size(std::max(1, cvRound(k.cols * q)), std::max(1, cvRound(k.rows * q))), 0, 0,
                           cv::INTER_AREA);
     cv::Mat s;
@@ -301,7 +295,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   bool redetected = false;
   int windows = 1;
   if (p_.redetection && unconfident_frames_ >= p_.lost_frames) {
-    const std::vector<cv::Point2d> around = neighbour_windows(pos_, window_ * scale_, frame.size());
+    const std::vector<cv::Point2d> around = neighbour_windows(pos_, fw_.window * scale_, frame.size());
     const bool corners = (unconfident_frames_ - p_.lost_frames) % 2 == 1;
     for (size_t k = 0; k < around.size(); ++k) {
       const bool corner = k == 0 || k == 2 || k == 5 || k == 7;  // neighbour_windows' row-major order
@@ -324,7 +318,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   unconfident_frames_ = confident ? 0 : unconfident_frames_ + 1;
 
   const cv::Point2d shift = peak_offset(d);
-  const double px_per_cell = p_.cell * window_.width * scale_ / model_.width;
+  const double px_per_cell = p_.cell * fw_.window.width * scale_ / fw_.model.width;
   pos_.x = std::clamp(d.centre.x + shift.x * px_per_cell, 0.0, frame.cols - 1.0);
   pos_.y = std::clamp(d.centre.y + shift.y * px_per_cell, 0.0, frame.rows - 1.0);
   if (confident) {
@@ -337,7 +331,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
     if (++since_training_ >= p_.update_interval) train();
     scale_filter_.learn(frame, pos_, scale_, p_.scale_learning_rate);
     if (p_.hist_weight > 0)
-      colour_model_.learn(subwindow(frame, pos_, window_ * scale_, model_), target_in_model(), p_.hist_learning_rate);
+      colour_model_.learn(subwindow(frame, pos_, fw_.window * scale_, fw_.model), target_in_model(), p_.hist_learning_rate);
   }
 
   TrackState s;
@@ -349,7 +343,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   s.redetected = redetected;
   LevelStats level;
   level.evaluated = static_cast<int>(d.response.total()) * windows + (confident ? p_.scales : 0);
-  level.search_radius = static_cast<float>(std::min(window_.width, window_.height) * scale_ / 2);
+  level.search_radius = static_cast<float>(std::min(fw_.window.width, fw_.window.height) * scale_ / 2);
   s.levels.push_back(std::move(level));
   return s;
 }

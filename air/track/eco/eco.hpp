@@ -33,6 +33,7 @@
 #include "air/track/dcf/colour_histogram.hpp"
 #include "air/track/dcf/filters.hpp"
 #include "air/track/dcf/scale_filter.hpp"
+#include "air/track/dcf/window.hpp"
 #include "air/track/eco/sample_space.hpp"
 #include "air/track/tracker.hpp"
 
@@ -121,7 +122,7 @@ class EcoTracker : public Tracker {
   cv::Point2d peak_offset(const Detection& d) const;  // sub-cell peak as a shift in cells
   bool search_whole_image(const cv::Mat& frame, Detection& best, double& confidence) const;
   void add_sample(const Detection& d, cv::Point2d shift_cells);
-  cv::Size2d target_in_model() const { return target_ * (model_.width / window_.width); }
+  cv::Size2d target_in_model() const { return target_ * (fw_.model.width / fw_.window.width); }
   void train();
 
   EcoParams p_;
@@ -133,10 +134,7 @@ class EcoTracker : public Tracker {
   cv::Point2d pos_;
   cv::Size2d target_;           // initial target size, image pixels
   double scale_ = 1;
-  cv::Size2d window_;           // window at scale 1, image pixels
-  cv::Size model_;              // resized window, pixels (cells x cell)
-  cv::Size cells_;
-  cv::Mat hann_, yf_, mask_;
+  FilterWindow fw_;             // window, model size, cells, taper, support, label
   cv::Mat hog_projection_, cn_projection_;  // D x C per block
 
   SampleSpace samples_{1, 1, 0};
