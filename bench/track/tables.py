@@ -31,8 +31,9 @@ def main(native, resized=None):
         h, s = held.get(t), summary[t]
         line = f"| {t} | {f3(h['heldout_auc'])} | {f3(h['heldout_p20'])} | {float(h['heldout_cle']):.1f} | " \
                f"{f3(h['tuned_auc'])} | {f3(h['tuned_p20'])} | {float(h['tuned_cle']):.1f} | {float(s['mean_cpu_fps']):.0f} |"
-        if small and t in small:
-            line += f" {f3(small[t]['mean_success_auc'])} | {float(small[t]['mean_cpu_fps']):.0f} |"
+        if small:
+            line += (f" {f3(small[t]['mean_success_auc'])} | {float(small[t]['mean_cpu_fps']):.0f} |" if t in small
+                     else " — | — |")
         print(line)
     print()
     print("| tracker | fold | candidate chosen | tuned-on AUC | held-out AUC |")
