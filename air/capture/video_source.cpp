@@ -43,7 +43,10 @@ VideoFileSource::VideoFileSource(const std::string& file, double fps_fallback, b
     : file_(file), color_(color) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) throw std::runtime_error(file + ": video file does not exist");
-  if (!cap_.open(file, cv::CAP_ANY) || !cap_.isOpened())
+  // FFmpeg reads the containers and codecs a flight is recorded in. CAP_ANY would, for a file
+  // FFmpeg refuses, go on to probe every other backend, among them gphoto2's autodetection of
+  // USB cameras (which LeakSanitizer catches leaking inside libgphoto2).
+  if (!cap_.open(file, cv::CAP_FFMPEG) || !cap_.isOpened())
     throw std::runtime_error(file + ": cannot open the video (unsupported container or codec?)");
   fps_ = cap_.get(cv::CAP_PROP_FPS);
   if (!(fps_ > 0 && fps_ < 1000)) fps_ = fps_fallback;
