@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "air/track/dcf/cf_params.hpp"
 #include "air/track/dcf/fhog.hpp"
 #include "air/track/dcf/window.hpp"
 
@@ -34,23 +35,8 @@ void blend(std::vector<cv::Mat>& model, const std::vector<cv::Mat>& sample, doub
 }  // namespace
 
 void DcfParams::validate() const {
-  require(cell >= 1, "cell must be >= 1");
-  require(padding >= 0 && std::isfinite(padding), "padding must be >= 0");
-  require(template_area >= 16.0 * cell * cell, "template_area must hold at least 4x4 cells");
-  require(output_sigma > 0 && lambda > 0 && scale_lambda > 0 && scale_sigma > 0, "sigmas and lambdas must be > 0");
-  for (double r : {learning_rate, hist_learning_rate, scale_learning_rate, confidence_rate})
-    require(r > 0 && r <= 1, "learning rates must be in (0, 1]");
-  require(hist_weight >= 0 && hist_weight <= 1, "hist_weight must be in [0, 1]");
-  require(hist_bins >= 2 && hist_bins <= 256 && (hist_bins & (hist_bins - 1)) == 0,
-          "hist_bins must be a power of two in [2, 256]");
-  require(inner_padding >= 0 && inner_padding < 1, "inner_padding must be in [0, 1)");
-  require(scales >= 1 && scale_step > 1 && scale_model_area >= 4.0 * cell * cell * 4, "bad scale filter settings");
-  require(min_scale > 0 && max_scale >= min_scale, "need 0 < min_scale <= max_scale");
-  require(update_confidence >= 0 && update_confidence <= 1 && found_confidence >= 0 && found_confidence <= 1,
-          "update_confidence and found_confidence must be in [0, 1]");
-  require(lost_frames >= 1, "lost_frames must be >= 1");
-  require(mask_scale > 0, "mask_scale must be > 0");
-  require(admm_iterations >= 0 && admm_mu > 0 && admm_beta >= 1 && admm_mu_max >= admm_mu, "bad ADMM settings");
+  validate_correlation_filter(*this, "dcf");
+  require(admm_mu > 0 && admm_beta >= 1 && admm_mu_max >= admm_mu, "bad ADMM settings");
 }
 
 cv::Mat masked_filter(const cv::Mat& xf, const cv::Mat& yf, const cv::Mat& mask, const DcfParams& p) {
@@ -203,11 +189,7 @@ TrackState DcfTracker::update(const cv::Mat& frame) {
       Detection candidate = detect(frame, c);
       ++windows;
       const double conf = confidence_of(candidate);
-      if (conf >= p_.found_confidence && conf > confidence) {
-        d = std::move(candidate);
-        confidence = conf;
-        redetected = true;
-      }
+      redetected = take_if_better(std::move(candidate), conf, p_.found_confidence, d, confidence) || redetected;
     }
   }
   mean_peak_ += p_.confidence_rate * (d.peak - mean_peak_);

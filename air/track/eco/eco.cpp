@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "air/track/dcf/cf_params.hpp"
 #include "air/track/dcf/fhog.hpp"
 #include "air/track/dcf/window.hpp"
 #include "air/track/eco/colour_names.hpp"
@@ -48,30 +49,13 @@ cv::Mat shifted(const cv::Mat& spectrum, cv::Point2d d) {
 }  // namespace
 
 void EcoParams::validate() const {
-  require(cell >= 1, "cell must be >= 1");
-  require(padding >= 0 && std::isfinite(padding), "padding must be >= 0");
-  require(template_area >= 16.0 * cell * cell, "template_area must hold at least 4x4 cells");
-  require(output_sigma > 0 && lambda > 0 && scale_lambda > 0 && scale_sigma > 0, "sigmas and lambdas must be > 0");
-  require(mask_scale > 0, "mask_scale must be > 0");
-  require(admm_iterations >= 0, "admm_iterations must be >= 0");
+  validate_correlation_filter(*this, "eco");
   require(hog_dims >= 1 && hog_dims <= kHogBlock, "hog_dims must be in [1, 32]");
   require(cn_dims >= 0 && cn_dims <= kColourNames, "cn_dims must be in [0, 11]");
   require(samples >= 1, "samples must be >= 1");
-  for (double r : {learning_rate, scale_learning_rate, confidence_rate})
-    require(r > 0 && r <= 1, "learning rates must be in (0, 1]");
   require(update_interval >= 1, "update_interval must be >= 1");
   require(aberrance >= 0 && std::isfinite(aberrance), "aberrance must be >= 0");
   require(newton_iterations >= 0, "newton_iterations must be >= 0");
-  require(hist_weight >= 0 && hist_weight <= 1, "hist_weight must be in [0, 1]");
-  require(hist_bins >= 2 && hist_bins <= 256 && (hist_bins & (hist_bins - 1)) == 0,
-          "hist_bins must be a power of two in [2, 256]");
-  require(hist_learning_rate > 0 && hist_learning_rate <= 1, "hist_learning_rate must be in (0, 1]");
-  require(inner_padding >= 0 && inner_padding < 1, "inner_padding must be in [0, 1)");
-  require(scales >= 1 && scale_step > 1 && scale_model_area >= 4.0 * cell * cell * 4, "bad scale filter settings");
-  require(min_scale > 0 && max_scale >= min_scale, "need 0 < min_scale <= max_scale");
-  require(update_confidence >= 0 && update_confidence <= 1 && found_confidence >= 0 && found_confidence <= 1,
-          "update_confidence and found_confidence must be in [0, 1]");
-  require(lost_frames >= 1, "lost_frames must be >= 1");
   require(lost_confidence >= 0 && lost_confidence <= 1, "lost_confidence must be in [0, 1]");
   require(lost_after >= 1, "lost_after must be >= 1");
   require(global_interval >= 0, "global_interval must be >= 0");
@@ -269,11 +253,7 @@ bool EcoTracker::search_whole_image(const cv::Mat& frame, Detection& best, doubl
     Detection d = detect(frame, clamped(c));
     d = detect(frame, clamped(d.centre + peak_offset(d) * (p_.cell / r)));
     const double conf = confidence_of(d);
-    if (conf >= p_.found_confidence && conf > confidence) {
-      best = std::move(d);
-      confidence = conf;
-      found = true;
-    }
+    found = take_if_better(std::move(d), conf, p_.found_confidence, best, confidence) || found;
   }
   return found;
 }
@@ -303,11 +283,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
       Detection candidate = detect(frame, around[k]);
       ++windows;
       const double conf = confidence_of(candidate);
-      if (conf >= p_.found_confidence && conf > confidence) {
-        d = std::move(candidate);
-        confidence = conf;
-        redetected = true;
-      }
+      redetected = take_if_better(std::move(candidate), conf, p_.found_confidence, d, confidence) || redetected;
     }
     if (p_.global_interval > 0 && (unconfident_frames_ - p_.lost_frames) % p_.global_interval == 0) {
       windows += p_.global_candidates;

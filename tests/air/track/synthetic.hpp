@@ -5,6 +5,8 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace aerie::track::test {
@@ -60,5 +62,19 @@ class Scene {
  private:
   cv::Mat background_, target_;
 };
+
+// The message with which a tracker built from the default parameters changed by `change` is
+// refused, or "accepted".
+template <typename TrackerType, typename Params, typename Change>
+std::string rejection(Change change) {
+  Params p;
+  change(p);
+  try {
+    TrackerType t(p);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "accepted";
+}
 
 }  // namespace aerie::track::test

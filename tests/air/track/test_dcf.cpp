@@ -262,16 +262,7 @@ TEST(Dcf, RedetectionAfterAJump) {
 }
 
 TEST(Dcf, BadParametersAreNamed) {
-  auto message = [](auto change) {
-    DcfParams p;
-    change(p);
-    try {
-      DcfTracker t(p);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no exception");
-  };
+  auto message = [](auto change) { return test::rejection<DcfTracker, DcfParams>(change); };
   EXPECT_NE(message([](DcfParams& p) { p.hist_bins = 30; }).find("hist_bins"), std::string::npos);
   EXPECT_NE(message([](DcfParams& p) { p.learning_rate = 0; }).find("learning rates"), std::string::npos);
   EXPECT_NE(message([](DcfParams& p) { p.padding = NAN; }).find("padding"), std::string::npos);

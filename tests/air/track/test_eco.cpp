@@ -261,16 +261,7 @@ TEST(Eco, SameInputSameTrack) {
 }
 
 TEST(Eco, BadParametersAreNamed) {
-  auto message = [](auto change) {
-    EcoParams p;
-    change(p);
-    try {
-      EcoTracker t(p);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
+  auto message = [](auto change) { return test::rejection<EcoTracker, EcoParams>(change); };
   EXPECT_NE(message([](EcoParams& p) { p.hog_dims = 40; }).find("hog_dims"), std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.cn_dims = -1; }).find("cn_dims"), std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.update_interval = 0; }).find("update_interval"), std::string::npos);
