@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   app.add_option("--multisamples", opts.multisamples, "OpenGL anti-aliasing samples (0: off, best without a GPU)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  app.add_option("--trim-period", opts.trim_period_s,
+                 "hand the heap's free memory back to the kernel (malloc_trim) every this many seconds (0: never)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--duration", duration, "exit after this many seconds (headless runs)");
   app.add_option("--disable", disable, "renderers to start disabled (by name, e.g. octomap chart-latency)");
   CLI11_PARSE(app, argc, argv);

@@ -1,5 +1,7 @@
 #include "ground/viewer/viewer.hpp"
 
+#include "ground/viewer/heap.hpp"
+
 #include <spdlog/spdlog.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -16,6 +18,7 @@
 
 #include "common/bus/node.hpp"
 #include "common/util/time.hpp"
+#include "ground/viewer/heap.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -27,9 +30,11 @@ struct Viewer::Help {
 };
 
 Viewer::Viewer(bus::Bus& bus, ViewerOptions options)
-    : bus_(bus), options_(std::move(options)), help_(std::make_unique<Help>()) {
+    : bus_(bus), options_(std::move(options)), status_(bus, "viewer"), help_(std::make_unique<Help>()) {
   if (options_.trackers.empty()) throw std::invalid_argument("viewer: the tracker menu is empty");
   if (!(options_.pane_fps > 0)) throw std::invalid_argument("viewer: pane_fps must be positive");
+  if (!(options_.trim_period_s >= 0)) throw std::invalid_argument("viewer: trim_period_s must be >= 0");
+  last_trim_s_ = util::mono_ms() / 1000.0;
   layout_ = Layout::create(options_.width, options_.height, options_.offscreen, options_.multisamples);
   panes_.push_back({layout_.image});
   panes_.push_back({layout_.scene});
@@ -161,7 +166,25 @@ bool Viewer::schedule_panes(bool image_changed, const std::vector<vtkRenderer*>&
   return any;
 }
 
+void Viewer::housekeeping() {
+  const double now = util::mono_ms() / 1000.0;
+  if (options_.trim_period_s > 0 && now - last_trim_s_ >= options_.trim_period_s) {
+    status_.count("heap_trims");
+    status_.count("heap_released_kb", trim_heap());
+    last_trim_s_ = now;
+  }
+  if (now - last_status_s_ < 1.0) return;
+  last_status_s_ = now;
+  const HeapFigures heap = heap_figures();
+  status_.set("frames_rendered", frames_rendered_);
+  status_.set("heap_in_use_kb", heap.in_use_kb);
+  status_.set("heap_free_kb", heap.free_kb);
+  status_.set("rss_kb", heap.rss_kb);
+  status_.tick();
+}
+
 bool Viewer::render_frame() {
+  housekeeping();
   bool overlay_changed = selection_.has_value();
   bool changed = false;
   std::vector<vtkRenderer*> changed_panes;

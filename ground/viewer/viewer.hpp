@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/bus/bus.hpp"
+#include "common/bus/status.hpp"
 #include "ground/viewer/image_pane.hpp"
 #include "ground/viewer/layout.hpp"
 #include "ground/viewer/renderer.hpp"
@@ -37,6 +38,9 @@ struct ViewerOptions {
   bool always_redraw = false;
   // OctoMap display: more quads than this and the map is shown one level coarser (0: no limit).
   size_t map_max_quads = 60000;
+  // Freed memory that glibc's arenas hold is handed back to the kernel this often
+  // (malloc_trim, ground/viewer/heap.hpp); 0: never.
+  double trim_period_s = 10;
   std::string image_channel = "CAM_LEFT";
   std::string track_cmd_channel = "TRACK_CMD";
   std::vector<std::string> trackers = {"amcmr-ct", "am3", "ipsl-mr", "ct", "mil", "ipsl"};
@@ -91,6 +95,8 @@ class Viewer {
   // Chooses the panes due for drawing (vtkRenderer::SetDraw); false when none is.
   bool schedule_panes(bool image_changed, const std::vector<vtkRenderer*>& changed);
   void update_help_text();
+  // Once a second: STATUS_VIEWER with the frames drawn and the heap (heap.hpp); the heap trim.
+  void housekeeping();
 
   bus::Bus& bus_;
   ViewerOptions options_;
@@ -104,6 +110,8 @@ class Viewer {
   size_t tracker_index_ = 0;
   bool paused_ = false;
   int64_t frames_rendered_ = 0;
+  bus::StatusReporter status_;
+  double last_trim_s_ = 0, last_status_s_ = -1;
   struct PaneState {
     vtkRenderer* pane;
     bool pending = true;            // content changed since it was last drawn
