@@ -18,7 +18,7 @@ Eigen::Vector3d vec3(const util::Config& cfg, const std::string& key, const Eige
 
 NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   sim::require_known_keys(cfg, {"controller", "input", "channels", "rate_hz", "reference_deg", "reference_relative",
-                                "forward_speed_m_s", "activation_distance_m", "stale_timeout_s", "limits", "heading_frame",
+                                "forward_speed_m_s", "activation_distance_m", "stale_timeout_s", "max_input_age_s", "limits", "heading_frame",
                                 "message_time"});
   NodeSetup s;
   const std::string file = !cli.controller.empty() ? cli.controller : cfg.get<std::string>("controller", "");
@@ -43,6 +43,7 @@ NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   c.forward_speed_m_s = cli.forward_speed.value_or(cfg.get("forward_speed_m_s", c.forward_speed_m_s));
   c.activation_distance_m = cfg.get("activation_distance_m", c.activation_distance_m);
   c.stale_timeout_s = cli.stale_timeout_s.value_or(cfg.get("stale_timeout_s", c.stale_timeout_s));
+  c.max_input_age_s = cfg.get("max_input_age_s", c.max_input_age_s);
   const auto lim = cfg.section("limits");
   sim::require_known_keys(lim, {"max_yaw_rate_deg_s", "max_yaw_accel_deg_s2"});
   c.limits.max_yaw_rate_deg_s = lim.get("max_yaw_rate_deg_s", c.limits.max_yaw_rate_deg_s);

@@ -16,6 +16,9 @@ void ControlConfig::validate() const {
                                 std::to_string(activation_distance_m));
   if (!(stale_timeout_s > 0.0 && stale_timeout_s <= 60.0))
     throw std::invalid_argument("control: stale_timeout_s must be in (0, 60] s, got " + std::to_string(stale_timeout_s));
+  if (!(max_input_age_s >= 0.0 && max_input_age_s <= 60.0))
+    throw std::invalid_argument("control: max_input_age_s must be in [0, 60] s (0 = off), got " +
+                                std::to_string(max_input_age_s));
   if (!(limits.max_yaw_rate_deg_s > 0.0 && limits.max_yaw_rate_deg_s <= 720.0))
     throw std::invalid_argument("control: limits.max_yaw_rate_deg_s must be in (0, 720] deg/s, got " +
                                 std::to_string(limits.max_yaw_rate_deg_s));
@@ -32,11 +35,12 @@ bool ControlLoop::stale(int64_t now_us) const {
 }
 
 bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us,
-                             const std::optional<Eigen::Vector3d>& position) {
+                             const std::optional<Eigen::Vector3d>& position, std::optional<double> age_s) {
   if (!std::isfinite(heading_deg) || (position && !position->allFinite())) return false;
   if (have_time_ && utime <= last_utime_) return false;
-  // Input resumed after going stale: the derivative and integral start afresh.
-  if (have_input_ && stale(receive_wall_us)) loop_.reset();
+  // Input resumed after going stale or old: the derivative and integral start afresh.
+  if (have_input_ && (stale(receive_wall_us) || aged_)) loop_.reset();
+  aged_ = cfg_.max_input_age_s > 0 && age_s && *age_s > cfg_.max_input_age_s;
   if (!have_reference_) {
     reference_ = cfg_.reference_relative ? flc::wrap_deg(heading_deg + cfg_.reference_deg) : cfg_.reference_deg;
     have_reference_ = true;
@@ -47,7 +51,7 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
   if (!turning_)
     turning_ = cfg_.activation_distance_m <= 0.0 ||
                (position && start_ && (*position - *start_).norm() >= cfg_.activation_distance_m);
-  const double u = turning_ ? loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_) : 0.0;
+  const double u = turning_ && !aged_ ? loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_) : 0.0;
   have_input_ = have_time_ = true;
   last_utime_ = utime;
   last_receive_ = receive_wall_us;
@@ -56,7 +60,7 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
   active_.forward_speed_m_s = cfg_.forward_speed_m_s;
   active_.heading_deg = heading_deg;
   active_.reference_deg = reference_;
-  active_.error_deg = turning_ ? loop_.inputs()[0] : flc::wrap_deg(reference_ - heading_deg);
+  active_.error_deg = turning_ && !aged_ ? loop_.inputs()[0] : flc::wrap_deg(reference_ - heading_deg);
   active_.source_utime = utime;
   return true;
 }
@@ -82,7 +86,7 @@ Command ControlLoop::command(int64_t now_us) const {
     c = Command{};
     c.controller_id = controller().id;
     c.mode = Mode::kHover;
-  } else if (stale(now_us)) {
+  } else if (stale(now_us) || aged_) {
     c.mode = Mode::kFallbackHover;
     c.yaw_rate_deg_s = 0.0;
     c.forward_speed_m_s = 0.0;

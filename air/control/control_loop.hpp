@@ -21,6 +21,10 @@ struct ControlConfig {
   bool reference_relative = true;     // reference is relative to the first heading received
   double forward_speed_m_s = 0.0;     // forward speed commanded while active
   double stale_timeout_s = 0.5;       // no heading for longer than this -> fallback hover
+  // A heading older than this when it arrives (its capture time against the node's clock)
+  // -> fallback hover; 0 = off. The delayed-link study (docs/results/linkstudy.md §4): from
+  // 200 ms the turn no longer settles, a gap-only timeout never fires behind a steady delay.
+  double max_input_age_s = 0.2;
   // > 0: the avoidance of thesis 5.1.2 — fly straight ahead (zero yaw rate) until the pose has
   // moved this far from the first one (the normal flight area), then turn to the reference.
   // 0: the reference applies from the first heading.
@@ -46,8 +50,12 @@ class ControlLoop {
   // derivative and integral) and the wall-clock time it was received (for staleness).
   // Returns false (and ignores it) if it is not newer than the last one or not finite.
   // `position` (any fixed frame, m) is the pose's; activation_distance_m measures it.
+  // `age_s` is the heading's age on arrival (util::message_age_s; nullopt when the clocks
+  // differ): older than max_input_age_s, the manoeuvre's progress follows it but the loop
+  // is reset and the commands are FALLBACK_HOVER until a fresh heading comes.
   bool on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us,
-                  const std::optional<Eigen::Vector3d>& position = std::nullopt);
+                  const std::optional<Eigen::Vector3d>& position = std::nullopt,
+                  std::optional<double> age_s = std::nullopt);
 
   // The heading source re-synchronised to a new time base (restart, outage; util::MessageClock):
   // the next heading is taken whatever its utime, and the derivative and integral start afresh.
@@ -63,6 +71,7 @@ class ControlLoop {
   const flc::FlcSpec& controller() const { return loop_.flc().spec(); }
   const ControlConfig& config() const { return cfg_; }
   bool stale(int64_t now_us) const;
+  bool aged() const { return aged_; }  // the newest heading was older than max_input_age_s
   bool turning() const { return turning_; }  // past the activation distance (or none configured)
 
  private:
@@ -70,7 +79,7 @@ class ControlLoop {
   flc::HeadingLoop loop_;
   bool have_input_ = false, have_reference_ = false, have_time_ = false;
   double reference_ = 0.0;
-  bool turning_ = false;
+  bool turning_ = false, aged_ = false;
   std::optional<Eigen::Vector3d> start_;  // the first pose's position
   int64_t last_utime_ = 0, last_receive_ = 0;
   Command active_;

@@ -159,11 +159,20 @@ void ControlNode::on_heading(int64_t utime, double heading_deg, const Eigen::Vec
     refuse_mission("the first pose is " + std::to_string(from_origin) + " m from " + opt_.pose_channel +
                    "'s origin: not the start of the manoeuvre (aerie-control restarted in flight?)");
   had_pose_ = true;
-  if (!loop_.on_heading(utime, heading_deg, receive_us, position)) {
+  const std::optional<double> age_s = util::message_age_s(utime, receive_us);
+  if (!loop_.on_heading(utime, heading_deg, receive_us, position, age_s)) {
     status_.count("pose_out_of_order");
     return;
   }
   status_.count("poses");
+  // The newest pose's age on this node's clock; -1 when the clocks are not comparable.
+  status_.set("input_age_ms", age_s ? std::llround(*age_s * 1e3) : -1);
+  if (loop_.aged()) {
+    status_.count("aged_poses");
+    if (aged_poses_++ % 100 == 0)
+      spdlog::warn("pose on {} is {:.0f} ms old (limit {:.0f} ms): hovering until a fresh one ({} so far)",
+                   opt_.pose_channel, *age_s * 1e3, loop_.config().max_input_age_s * 1e3, aged_poses_);
+  }
   last_receive_ = receive_us;
 }
 

@@ -74,7 +74,7 @@ class ControlNode {
   int64_t seq_ = 0, next_publish_ = 0, period_us_ = 0, last_receive_ = 0;
   util::NodeClock now_;
   bus::InputClock pose_clock_;  // the message-time policy of the pose source
-  int64_t bad_poses_ = 0;
+  int64_t bad_poses_ = 0, aged_poses_ = 0;
   bool source_was_ok_ = false, had_pose_ = false;
   static constexpr int kNavRestartMessages = 3;  // INITIALISING in a row after OK: a restart
   int initialising_run_ = 0;

@@ -87,16 +87,7 @@ bool PilotNode::on_time(util::MessageClock& clock, const std::string& channel, i
   return false;
 }
 
-std::optional<double> PilotNode::input_age(int64_t utime) {
-  const double age_s = (static_cast<double>(now_()) - static_cast<double>(utime)) * 1e-6;
-  // A minute apart, the frame was not stamped on this clock: a lock-step simulation starts
-  // at 0, a replayed log at its recording. No link delays a frame that long.
-  if (std::abs(age_s) > kComparableClockS) {
-    last_age_s_.reset();
-    return std::nullopt;
-  }
-  return last_age_s_ = age_s;
-}
+std::optional<double> PilotNode::input_age(int64_t utime) { return last_age_s_ = util::message_age_s(utime, now_()); }
 
 void PilotNode::publish(const Command& c) {
   const PilotStatus& s = pilot_.status();

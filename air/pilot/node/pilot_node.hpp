@@ -42,10 +42,8 @@ class PilotNode {
   void count(const std::string& name) { ++counters_[name]; }
   // The message-time policy: false (counted "<channel>_time_held", logged) for a held stamp.
   bool on_time(util::MessageClock& clock, const std::string& channel, int64_t utime);
-  // A frame's age on the node's clock (PilotConfig::max_input_age_s), or nullopt when its
-  // stamp is more than kComparableClockS from that clock (not the same time base).
+  // A frame's age on the node's clock (PilotConfig::max_input_age_s; util::message_age_s).
   std::optional<double> input_age(int64_t utime);
-  static constexpr double kComparableClockS = 60;
 
   bus::Bus& bus_;
   Pilot pilot_;

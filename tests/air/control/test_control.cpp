@@ -323,6 +323,8 @@ TEST(ControlConfig, RefusesTimeoutsAndRatesOutsideTheirRanges) {
       {"message_time:\n  resync_messages: 0\n", "message_time: key 'resync_messages' = 0 is outside its valid range [1, 1000]"},
       {"message_time:\n  stale_timeout_s: 1\n", "staleness is the top-level 'stale_timeout_s'"},
       {"message_time:\n  max_jumps: 1\n", "message_time: unknown key 'max_jumps' (line 2"},
+      {"max_input_age_s: -0.1\n", "control.yaml: control: max_input_age_s must be in [0, 60] s (0 = off)"},
+      {"max_input_age_s: .nan\n", "max_input_age_s must be in [0, 60] s"},
   });
   EXPECT_EQ(test::refusal(load, "stale_timeout_s: 60\nlimits:\n  max_yaw_rate_deg_s: 720\n"), "");
   const auto setup = node_setup(util::Config::parse("message_time:\n  max_jump_s: 2.5\n  resync_messages: 5\n", "c.yaml"));
@@ -332,6 +334,8 @@ TEST(ControlConfig, RefusesTimeoutsAndRatesOutsideTheirRanges) {
   const auto shipped = node_setup(util::Config::load((test::source_dir() / "config" / "control.yaml").string()));
   EXPECT_EQ(shipped.options.message_time.max_jump_us, 10'000'000);
   EXPECT_EQ(shipped.options.message_time.resync_messages, 3);
+  EXPECT_EQ(shipped.options.control.max_input_age_s, 0.2);
+  EXPECT_EQ(node_setup(util::Config::parse("max_input_age_s: 0\n", "c.yaml")).options.control.max_input_age_s, 0.0);
 }
 
 namespace {
@@ -435,6 +439,68 @@ TEST(ControlNode, A25SecondCameraOutageHoversReportsStaleAndRecovers) {
   EXPECT_EQ(s.status.counter("VO_POSE.stale"), 0);
   EXPECT_EQ(s.status.counter("VO_POSE.time_resyncs"), 1);
   EXPECT_EQ(s.status.counter("pose_out_of_order"), 0);
+}
+
+TEST(ControlLoop, AnOldHeadingHoversAndTheLoopRestartsOnAFreshOne) {
+  ControlConfig cfg;
+  cfg.forward_speed_m_s = 0.6;
+  cfg.activation_distance_m = 1.0;
+  ASSERT_EQ(cfg.max_input_age_s, 0.2);
+  ControlLoop loop(tuned(), cfg), reference(tuned(), cfg);
+  const Eigen::Vector3d start(0, 0, 0), far(2, 0, 0);
+  // Fresh (0.05 s), then unknown age (another clock): flown.
+  ASSERT_TRUE(loop.on_heading(1'000'000, 10.0, 1'050'000, start, 0.05));
+  EXPECT_EQ(loop.command(1'050'000).mode, Mode::kActive);
+  ASSERT_TRUE(loop.on_heading(1'033'333, 10.0, 1'083'333, start, std::nullopt));
+  EXPECT_EQ(loop.command(1'083'333).mode, Mode::kActive);
+  EXPECT_FALSE(loop.aged());
+  // 0.3 s old: hover with no speed and no turn; the manoeuvre still moves past its
+  // activation distance on it.
+  ASSERT_TRUE(loop.on_heading(1'066'666, 30.0, 1'366'666, far, 0.3));
+  const Command old = loop.command(1'366'666);
+  EXPECT_TRUE(loop.aged());
+  EXPECT_EQ(old.mode, Mode::kFallbackHover);
+  EXPECT_EQ(old.yaw_rate_deg_s, 0.0);
+  EXPECT_EQ(old.forward_speed_m_s, 0.0);
+  EXPECT_TRUE(loop.turning());
+  // Exactly the limit is still flown; fresh again, the FLC starts afresh: the same command
+  // as a loop that turns on this heading first.
+  ASSERT_TRUE(loop.on_heading(1'100'000, 40.0, 1'300'000, far, 0.2));
+  EXPECT_FALSE(loop.aged());
+  ASSERT_TRUE(reference.on_heading(1'000'000, 10.0, 1'050'000, start, 0.0));
+  ASSERT_TRUE(reference.on_heading(1'100'000, 40.0, 1'300'000, far, 0.0));
+  const Command fresh = loop.command(1'300'000), want = reference.command(1'300'000);
+  EXPECT_EQ(fresh.mode, Mode::kActive);
+  EXPECT_DOUBLE_EQ(fresh.yaw_rate_deg_s, want.yaw_rate_deg_s);
+  EXPECT_DOUBLE_EQ(fresh.error_deg, want.error_deg);
+  // 0 turns the rule off.
+  cfg.max_input_age_s = 0;
+  ControlLoop off(tuned(), cfg);
+  ASSERT_TRUE(off.on_heading(1'000'000, 10.0, 1'050'000, start, 30.0));
+  EXPECT_EQ(off.command(1'050'000).mode, Mode::kActive);
+}
+
+TEST(ControlNode, PosesBehindADelayedLinkHoverAndAreCounted) {
+  // Poses stamped on the node's clock and delivered 300 ms late (a steady delay: no gap, so
+  // never stale), then 50 ms late.
+  LockStep s({}, 5'000'000);
+  int64_t t = 5'000'000;
+  for (int k = 0; k < 30; ++k, t += 33'333) {
+    s.now = t + 300'000;
+    const auto c = s.step(t);
+    EXPECT_EQ(c.mode, aerie::control_cmd_t::FALLBACK_HOVER) << k;
+    EXPECT_EQ(c.velocity_body[0], 0.0f);
+  }
+  EXPECT_EQ(s.status.counter("aged_poses"), 30);
+  EXPECT_EQ(s.status.counter("input_age_ms"), 300);
+  EXPECT_EQ(s.status.counter("VO_POSE.stale"), 0);
+  t += 250'000;  // the delay falls to 50 ms: the node's clock runs on, a pose is skipped
+  for (int k = 0; k < 30; ++k, t += 33'333) {
+    s.now = t + 50'000;
+    ASSERT_EQ(s.step(t).mode, aerie::control_cmd_t::ACTIVE) << k;
+  }
+  EXPECT_EQ(s.status.counter("aged_poses"), 30);
+  EXPECT_EQ(s.status.counter("input_age_ms"), 50);
 }
 
 TEST(ControlLoop, FliesStraightUntilTheActivationDistanceThenTurns) {
