@@ -38,9 +38,8 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
                              const std::optional<Eigen::Vector3d>& position, std::optional<double> age_s) {
   if (!std::isfinite(heading_deg) || (position && !position->allFinite())) return false;
   if (have_time_ && utime <= last_utime_) return false;
-  // Input resumed after going stale or old: the derivative and integral start afresh.
-  if (have_input_ && (stale(receive_wall_us) || aged_)) loop_.reset();
-  aged_ = cfg_.max_input_age_s > 0 && age_s && *age_s > cfg_.max_input_age_s;
+  have_time_ = true;
+  last_utime_ = utime;
   if (!have_reference_) {
     reference_ = cfg_.reference_relative ? flc::wrap_deg(heading_deg + cfg_.reference_deg) : cfg_.reference_deg;
     have_reference_ = true;
@@ -51,16 +50,21 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
   if (!turning_)
     turning_ = cfg_.activation_distance_m <= 0.0 ||
                (position && start_ && (*position - *start_).norm() >= cfg_.activation_distance_m);
-  const double u = turning_ && !aged_ ? loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_) : 0.0;
-  have_input_ = have_time_ = true;
-  last_utime_ = utime;
+  // Too old to fly on: the FLC does not see it and the commands hover; the staleness clock
+  // keeps running from the last fresh heading.
+  aged_ = cfg_.max_input_age_s > 0 && age_s && *age_s > cfg_.max_input_age_s;
+  if (aged_) return true;
+  // Fresh input after none for stale_timeout_s: the derivative and integral start afresh.
+  if (have_input_ && stale(receive_wall_us)) loop_.reset();
+  const double u = turning_ ? loop_.update(static_cast<double>(utime) * 1e-6, heading_deg, reference_) : 0.0;
+  have_input_ = true;
   last_receive_ = receive_wall_us;
   active_.mode = Mode::kActive;
   active_.yaw_rate_deg_s = u;
   active_.forward_speed_m_s = cfg_.forward_speed_m_s;
   active_.heading_deg = heading_deg;
   active_.reference_deg = reference_;
-  active_.error_deg = turning_ && !aged_ ? loop_.inputs()[0] : flc::wrap_deg(reference_ - heading_deg);
+  active_.error_deg = turning_ ? loop_.inputs()[0] : flc::wrap_deg(reference_ - heading_deg);
   active_.source_utime = utime;
   return true;
 }
@@ -82,11 +86,11 @@ std::optional<std::string> ControlLoop::set_controller(const flc::FlcSpec& spec)
 Command ControlLoop::command(int64_t now_us) const {
   Command c = active_;
   c.controller_id = controller().id;
-  if (!have_input_) {
+  if (!have_input_ && !aged_) {
     c = Command{};
     c.controller_id = controller().id;
     c.mode = Mode::kHover;
-  } else if (stale(now_us) || aged_) {
+  } else if (!have_input_ || stale(now_us) || aged_) {
     c.mode = Mode::kFallbackHover;
     c.yaw_rate_deg_s = 0.0;
     c.forward_speed_m_s = 0.0;

@@ -51,8 +51,9 @@ class ControlLoop {
   // Returns false (and ignores it) if it is not newer than the last one or not finite.
   // `position` (any fixed frame, m) is the pose's; activation_distance_m measures it.
   // `age_s` is the heading's age on arrival (util::message_age_s; nullopt when the clocks
-  // differ): older than max_input_age_s, the manoeuvre's progress follows it but the loop
-  // is reset and the commands are FALLBACK_HOVER until a fresh heading comes.
+  // differ): older than max_input_age_s, the manoeuvre's progress follows it but the FLC
+  // never sees it and the commands are FALLBACK_HOVER until a fresh heading comes, as if it
+  // had not come (after no fresh heading for stale_timeout_s, the FLC starts afresh).
   bool on_heading(int64_t utime, double heading_deg, int64_t receive_wall_us,
                   const std::optional<Eigen::Vector3d>& position = std::nullopt,
                   std::optional<double> age_s = std::nullopt);

@@ -441,13 +441,19 @@ TEST(ControlNode, A25SecondCameraOutageHoversReportsStaleAndRecovers) {
   EXPECT_EQ(s.status.counter("pose_out_of_order"), 0);
 }
 
-TEST(ControlLoop, AnOldHeadingHoversAndTheLoopRestartsOnAFreshOne) {
+TEST(ControlLoop, AnOldHeadingIsNotFlownOnAndHovers) {
   ControlConfig cfg;
   cfg.forward_speed_m_s = 0.6;
   cfg.activation_distance_m = 1.0;
   ASSERT_EQ(cfg.max_input_age_s, 0.2);
-  ControlLoop loop(tuned(), cfg), reference(tuned(), cfg);
+  ASSERT_EQ(cfg.stale_timeout_s, 0.5);
   const Eigen::Vector3d start(0, 0, 0), far(2, 0, 0);
+  // Only aged headings so far: no flight yet, a fallback hover (not "no input").
+  ControlLoop never(tuned(), cfg);
+  ASSERT_TRUE(never.on_heading(1'000'000, 10.0, 1'300'000, start, 0.3));
+  EXPECT_EQ(never.command(1'300'000).mode, Mode::kFallbackHover);
+
+  ControlLoop loop(tuned(), cfg), reference(tuned(), cfg);
   // Fresh (0.05 s), then unknown age (another clock): flown.
   ASSERT_TRUE(loop.on_heading(1'000'000, 10.0, 1'050'000, start, 0.05));
   EXPECT_EQ(loop.command(1'050'000).mode, Mode::kActive);
@@ -463,16 +469,29 @@ TEST(ControlLoop, AnOldHeadingHoversAndTheLoopRestartsOnAFreshOne) {
   EXPECT_EQ(old.yaw_rate_deg_s, 0.0);
   EXPECT_EQ(old.forward_speed_m_s, 0.0);
   EXPECT_TRUE(loop.turning());
-  // Exactly the limit is still flown; fresh again, the FLC starts afresh: the same command
-  // as a loop that turns on this heading first.
-  ASSERT_TRUE(loop.on_heading(1'100'000, 40.0, 1'300'000, far, 0.2));
+  // Exactly the limit is flown: the FLC goes on as if the old heading had never come.
+  ASSERT_TRUE(loop.on_heading(1'100'000, 40.0, 1'400'000, far, 0.2));
   EXPECT_FALSE(loop.aged());
   ASSERT_TRUE(reference.on_heading(1'000'000, 10.0, 1'050'000, start, 0.0));
-  ASSERT_TRUE(reference.on_heading(1'100'000, 40.0, 1'300'000, far, 0.0));
-  const Command fresh = loop.command(1'300'000), want = reference.command(1'300'000);
+  ASSERT_TRUE(reference.on_heading(1'033'333, 10.0, 1'083'333, start, 0.0));
+  ASSERT_TRUE(reference.on_heading(1'100'000, 40.0, 1'400'000, far, 0.0));
+  ASSERT_TRUE(loop.on_heading(1'133'333, 45.0, 1'433'333, far, 0.1));
+  ASSERT_TRUE(reference.on_heading(1'133'333, 45.0, 1'433'333, far, 0.0));
+  const Command fresh = loop.command(1'433'333), want = reference.command(1'433'333);
   EXPECT_EQ(fresh.mode, Mode::kActive);
   EXPECT_DOUBLE_EQ(fresh.yaw_rate_deg_s, want.yaw_rate_deg_s);
   EXPECT_DOUBLE_EQ(fresh.error_deg, want.error_deg);
+  // Old headings for longer than stale_timeout_s: the next fresh one starts the FLC afresh,
+  // the same command as a new loop turning on it.
+  for (int k = 1; k <= 20; ++k)
+    ASSERT_TRUE(loop.on_heading(1'133'333 + k * 33'333, 45.0, 1'733'333 + k * 33'333, far, 0.3));
+  EXPECT_EQ(loop.command(2'400'000).mode, Mode::kFallbackHover);
+  ASSERT_TRUE(loop.on_heading(1'900'000, 50.0, 2'450'000, far, 0.05));
+  ControlLoop restarted(tuned(), cfg);
+  ASSERT_TRUE(restarted.on_heading(1'000'000, 10.0, 1'050'000, start, 0.0));
+  ASSERT_TRUE(restarted.on_heading(1'900'000, 50.0, 2'450'000, far, 0.0));
+  EXPECT_EQ(loop.command(2'450'000).mode, Mode::kActive);
+  EXPECT_DOUBLE_EQ(loop.command(2'450'000).yaw_rate_deg_s, restarted.command(2'450'000).yaw_rate_deg_s);
   // 0 turns the rule off.
   cfg.max_input_age_s = 0;
   ControlLoop off(tuned(), cfg);
