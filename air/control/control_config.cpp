@@ -18,7 +18,7 @@ Eigen::Vector3d vec3(const util::Config& cfg, const std::string& key, const Eige
 
 NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   sim::require_known_keys(cfg, {"controller", "input", "channels", "rate_hz", "reference_deg", "reference_relative",
-                                "forward_speed_m_s", "activation_distance_m", "stale_timeout_s", "max_input_age_s", "limits", "heading_frame",
+                                "forward_speed_m_s", "activation_distance_m", "stale_timeout_s", "max_input_age_s", "anchor_file", "limits", "heading_frame",
                                 "message_time"});
   NodeSetup s;
   const std::string file = !cli.controller.empty() ? cli.controller : cfg.get<std::string>("controller", "");
@@ -36,6 +36,7 @@ NodeSetup node_setup(const util::Config& cfg, const CliOverrides& cli) {
   o.params_channel = ch.get<std::string>("params", o.params_channel);
   o.command_channel = ch.get<std::string>("command", o.command_channel);
   o.rate_hz = cli.rate_hz.value_or(cfg.get("rate_hz", o.rate_hz));
+  o.anchor_file = cfg.get<std::string>("anchor_file", o.anchor_file);
 
   ControlConfig& c = o.control;
   c.reference_deg = cli.reference_deg.value_or(cfg.get("reference_deg", c.reference_deg));

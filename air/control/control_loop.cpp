@@ -44,6 +44,7 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
     reference_ = cfg_.reference_relative ? flc::wrap_deg(heading_deg + cfg_.reference_deg) : cfg_.reference_deg;
     have_reference_ = true;
     start_ = position;
+    anchor_utime_ = utime;
   }
   // The turn starts at the end of the normal flight area; until then the FLC is not run
   // (as in aerie-ceopt's scenario) and the vehicle flies straight.
@@ -67,6 +68,21 @@ bool ControlLoop::on_heading(int64_t utime, double heading_deg, int64_t receive_
   active_.error_deg = turning_ ? loop_.inputs()[0] : flc::wrap_deg(reference_ - heading_deg);
   active_.source_utime = utime;
   return true;
+}
+
+std::optional<Anchor> ControlLoop::anchor() const {
+  if (!have_reference_ || !start_) return std::nullopt;
+  return Anchor{anchor_utime_, *start_, reference_};
+}
+
+void ControlLoop::resume(const Anchor& a) {
+  if (!a.start.allFinite() || !std::isfinite(a.reference_deg))
+    throw std::invalid_argument("control: an anchor must be finite");
+  have_reference_ = true;
+  start_ = a.start;
+  reference_ = flc::wrap_deg(a.reference_deg);
+  anchor_utime_ = a.utime;
+  turning_ = false;  // from the next position
 }
 
 void ControlLoop::resync() {

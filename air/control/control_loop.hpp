@@ -33,6 +33,15 @@ struct ControlConfig {
   void validate() const;              // throws std::invalid_argument
 };
 
+// Where the manoeuvre was anchored: the first heading's pose in the estimator's frame and the
+// reference it set (thesis 5.1.2: straight for activation_distance_m from start, then turn
+// to reference_deg). Kept so that a restarted aerie-control can resume it (control_node.hpp).
+struct Anchor {
+  int64_t utime = 0;                  // of the pose that anchored it
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  double reference_deg = 0.0;
+};
+
 struct Command {
   Mode mode = Mode::kHover;
   double yaw_rate_deg_s = 0.0;
@@ -58,6 +67,12 @@ class ControlLoop {
                   const std::optional<Eigen::Vector3d>& position = std::nullopt,
                   std::optional<double> age_s = std::nullopt);
 
+  // The manoeuvre's anchor, once the first heading (with a position) has set it.
+  std::optional<Anchor> anchor() const;
+  // Takes up a manoeuvre anchored before (a restart): the next headings are flown against
+  // its start and reference instead of anchoring anew.
+  void resume(const Anchor& anchor);
+
   // The heading source re-synchronised to a new time base (restart, outage; util::MessageClock):
   // the next heading is taken whatever its utime, and the derivative and integral start afresh.
   void resync();
@@ -82,6 +97,7 @@ class ControlLoop {
   double reference_ = 0.0;
   bool turning_ = false, aged_ = false;
   std::optional<Eigen::Vector3d> start_;  // the first pose's position
+  int64_t anchor_utime_ = 0;
   int64_t last_utime_ = 0, last_receive_ = 0;
   Command active_;
 };

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "air/control/anchor_file.hpp"
 #include "common/bus/channels.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/util/time.hpp"
@@ -155,14 +156,27 @@ void ControlNode::on_heading(int64_t utime, double heading_deg, const Eigen::Vec
   if (time.verdict == util::MessageClock::Verdict::kResynced) loop_.resync();
   const double from_origin = position.head<2>().norm();
   if (!had_pose_ && opt_.input != NodeOptions::Input::kGtPose && loop_.config().activation_distance_m > 0 &&
-      from_origin > 0.5 * loop_.config().activation_distance_m)
-    refuse_mission("the first pose is " + std::to_string(from_origin) + " m from " + opt_.pose_channel +
-                   "'s origin: not the start of the manoeuvre (aerie-control restarted in flight?)");
+      from_origin > 0.5 * loop_.config().activation_distance_m) {
+    const std::string not_resumed = resume_anchor(utime);
+    if (!not_resumed.empty())
+      refuse_mission("the first pose is " + std::to_string(from_origin) + " m from " + opt_.pose_channel +
+                     "'s origin: not the start of the manoeuvre (aerie-control restarted in flight?), and " + not_resumed);
+  }
   had_pose_ = true;
+  const bool anchored = loop_.anchor().has_value();
   const std::optional<double> age_s = util::message_age_s(utime, receive_us);
   if (!loop_.on_heading(utime, heading_deg, receive_us, position, age_s)) {
     status_.count("pose_out_of_order");
     return;
+  }
+  if (!anchored && loop_.anchor() && !opt_.anchor_file.empty()) {
+    try {
+      write_anchor(opt_.anchor_file, opt_.pose_channel, *loop_.anchor());
+    } catch (const std::exception& e) {
+      status_.count("anchor_write_errors");
+      status_.warn(std::string("cannot keep the manoeuvre's anchor: ") + e.what());
+      spdlog::warn("cannot keep the manoeuvre's anchor: {}", e.what());
+    }
   }
   status_.count("poses");
   // The newest pose's age on this node's clock; -1 when the clocks are not comparable.
@@ -200,6 +214,23 @@ void ControlNode::tick(int64_t now_us) {
   publish_command(now_us);
   // Keep the fixed rate; after a long pause start again from now.
   next_publish_ = now_us - next_publish_ > period_us_ ? now_us + period_us_ : next_publish_ + period_us_;
+}
+
+std::string ControlNode::resume_anchor(int64_t utime) {
+  if (opt_.anchor_file.empty()) return "no anchor_file is configured to resume from";
+  std::string why;
+  std::optional<Anchor> a = read_anchor(opt_.anchor_file, opt_.pose_channel, why);
+  if (a && !(a->utime < utime && utime - a->utime <= kMaxAnchorAgeUs)) {
+    why = opt_.anchor_file + ": its anchor (utime " + std::to_string(a->utime) +
+          ") is not from the 10 minutes before this pose (another mission or another clock)";
+    a.reset();
+  }
+  if (!a) return why;
+  loop_.resume(*a);
+  status_.count("anchor_resumed");
+  spdlog::info("resumed the manoeuvre anchored at ({:.2f}, {:.2f}, {:.2f}) m, reference {:.1f} deg, utime {} ({})",
+               a->start.x(), a->start.y(), a->start.z(), a->reference_deg, a->utime, opt_.anchor_file);
+  return "";
 }
 
 void ControlNode::refuse_mission(const std::string& why) {

@@ -29,6 +29,10 @@ struct NodeOptions {
   double rate_hz = 30.0;              // CTRL_CMD rate; 0 = one command per message on the pose channel
   HeadingFrame frame;
   ControlConfig control;
+  // Where the manoeuvre's anchor is kept (anchor_file.hpp); "" = nowhere. With it, an
+  // aerie-control restarted in flight resumes the manoeuvre in the same estimator frame
+  // (an anchor of the same pose channel from the 10 minutes before); without, it refuses.
+  std::string anchor_file;
   // message_time.max_jump_s / resync_messages; its stale timeout is control.stale_timeout_s.
   util::MessageClockConfig message_time;
 };
@@ -64,8 +68,12 @@ class ControlNode {
   // good — FALLBACK_HOVER, health ERROR, until the mission is restarted — when that frame is
   // reset under it (the pose source initialising again: aerie-nav or aerie-vo restarted) or
   // when the first pose is already away from the frame's origin (aerie-control restarted in
-  // mid-flight): a reference re-anchored there could steer into the wall.
+  // mid-flight) and no anchor kept in anchor_file can be resumed: a reference re-anchored
+  // there could steer into the wall.
   void refuse_mission(const std::string& why);
+  // Resumes the manoeuvre from anchor_file; "" when it did, else why not.
+  std::string resume_anchor(int64_t utime);
+  static constexpr int64_t kMaxAnchorAgeUs = 600'000'000;
 
   bus::Bus& bus_;
   bus::StatusReporter& status_;

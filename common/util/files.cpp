@@ -23,4 +23,20 @@ std::string read_regular_file(const std::string& path, const std::string& what) 
   return ss.str();
 }
 
+void write_file_atomically(const std::string& path, const std::string& content) {
+  const std::string tmp = path + ".part";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << content;
+    out.flush();
+    if (!out) throw std::runtime_error(path + ": cannot write");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write (" + ec.message() + ")");
+  }
+}
+
 }  // namespace aerie::util

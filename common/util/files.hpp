@@ -11,5 +11,8 @@ namespace aerie::util {
 void require_regular_file(const std::string& path, const std::string& what = "file");
 // The whole file, after require_regular_file.
 std::string read_regular_file(const std::string& path, const std::string& what = "file");
+// Writes `content` next to `path` and renames it over `path`, so that a reader (or a node
+// killed mid-write) never sees a truncated file. Throws std::runtime_error naming the file.
+void write_file_atomically(const std::string& path, const std::string& content);
 
 }  // namespace aerie::util

@@ -3,8 +3,12 @@
 #include <aerie/control_cmd_t.hpp>
 #include <aerie/pose_t.hpp>
 
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <stdexcept>
 
@@ -20,6 +24,23 @@ namespace aerie::avoidance {
 namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 double wrap180(double a) { return std::remainder(a, 360.0); }
+
+// aerie-control's anchor file for one flight (control_node.hpp: anchor_file), as the vehicle
+// keeps it on its disk, so that a respawned aerie-control resumes the manoeuvre; one per
+// flight (flights run in parallel), removed with it.
+struct FlightAnchorFile {
+  std::string path;
+  FlightAnchorFile() {
+    static std::atomic<int64_t> next{0};
+    path = (std::filesystem::temp_directory_path() /
+            ("aerie-avoidance-" + std::to_string(::getpid()) + "-" + std::to_string(next++) + ".anchor"))
+               .string();
+  }
+  ~FlightAnchorFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);
+  }
+};
 }  // namespace
 
 Source source_from_name(const std::string& name) {
@@ -112,6 +133,8 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     case Source::kVio: co.input = control::NodeOptions::Input::kNavState; break;
   }
   co.pose_channel = control::default_pose_channel(co.input);
+  const FlightAnchorFile anchor_file;
+  co.anchor_file = anchor_file.path;
   co.frame = control::default_heading_frame(co.input);
   if (config.source != Source::kGt) {
     stereo::VoNodeConfig vc = config.vo;

@@ -5,8 +5,10 @@
 #include <Eigen/Geometry>
 #include <aerie/process_status_t.hpp>
 #include <cmath>
+#include <fstream>
 #include <optional>
 
+#include "air/control/anchor_file.hpp"
 #include "air/control/control_config.hpp"
 #include "air/control/control_loop.hpp"
 #include "air/control/control_node.hpp"
@@ -628,4 +630,66 @@ TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
     EXPECT_EQ(cmds.back().yaw_rate_deg_s, 0.0f);
     EXPECT_EQ(status.counter("mission_refused"), 1);
   }
+}
+
+TEST(ControlNode, ARestartedControlResumesTheManoeuvreFromItsAnchorFile) {
+  NodeOptions opt = nav_avoidance_options();
+  opt.anchor_file = (test::scratch_dir("control_anchor") / "control.anchor").string();
+  LockStep first(opt, 0), continuing(opt, 0);
+  // The mission starts at the frame's origin: the anchor is kept (the first OK pose).
+  for (auto* s : {&first, &continuing})
+    for (int k = 1; k <= 10; ++k) s->bus.publish("NAV_STATE", nav_state(s->now = k * 5'000, aerie::nav_state_t::OK, 0.04 * k));
+  drain(first.bus);
+  drain(continuing.bus);
+  std::string why;
+  const auto kept = read_anchor(opt.anchor_file, "NAV_STATE", why);
+  ASSERT_TRUE(kept) << why;
+  EXPECT_EQ(kept->utime, 5'000);
+  EXPECT_DOUBLE_EQ(kept->start.x(), 0.04);
+  EXPECT_DOUBLE_EQ(kept->reference_deg, 90.0);
+  // aerie-control dies; its respawn's first pose is 2 m out, past the activation distance:
+  // it resumes the manoeuvre and turns exactly as the one that lived on.
+  LockStep respawned(opt, 0);
+  for (auto* s : {&respawned, &continuing})
+    for (int k = 40; k <= 60; ++k) s->bus.publish("NAV_STATE", nav_state(s->now = k * 5'000, aerie::nav_state_t::OK, 0.05 * k));
+  drain(respawned.bus);
+  drain(continuing.bus);
+  EXPECT_EQ(respawned.status.counter("anchor_resumed"), 1);
+  EXPECT_EQ(respawned.status.counter("mission_refused"), 0);
+  ASSERT_EQ(respawned.cmds.size(), 21u);
+  ASSERT_EQ(continuing.cmds.size(), 31u);
+  for (size_t i = 0; i < respawned.cmds.size(); ++i) {
+    const auto &a = respawned.cmds[i], &b = continuing.cmds[10 + i];
+    ASSERT_EQ(a.mode, aerie::control_cmd_t::ACTIVE) << i;
+    EXPECT_EQ(a.yaw_rate_deg_s, b.yaw_rate_deg_s) << i;
+    EXPECT_EQ(a.heading_ref_deg, 90.0f);
+  }
+  EXPECT_GT(respawned.cmds.back().yaw_rate_deg_s, 1.0f);  // turning right, toward the reference
+
+  // Refused, with the reason, when the file cannot be taken up: another channel's, older than
+  // 10 minutes, or not an anchor file.
+  const auto refused_with = [&](const std::string& text, const std::string& reason) {
+    {
+      std::ofstream(opt.anchor_file, std::ios::trunc) << text;
+    }
+    LockStep s(opt, 0);
+    s.bus.publish("NAV_STATE", nav_state(s.now = 700'000'000, aerie::nav_state_t::OK, 2.0));
+    drain(s.bus);
+    EXPECT_EQ(s.status.counter("mission_refused"), 1) << text;
+    EXPECT_NE(s.status.message().find(reason), std::string::npos) << s.status.message();
+    EXPECT_EQ(s.cmds.back().mode, aerie::control_cmd_t::FALLBACK_HOVER);
+  };
+  refused_with("aerie-control anchor 1\nchannel VO_POSE\nutime 5000\nstart 0 0 0\nreference_deg 90\n",
+               "the anchor is in VO_POSE's frame, not NAV_STATE's");
+  refused_with("aerie-control anchor 1\nchannel NAV_STATE\nutime 5000\nstart 0 0 0\nreference_deg 90\n",
+               "is not from the 10 minutes before this pose");
+  refused_with("aerie-control anchor 1\nchannel NAV_STATE\nutime 600000000\nstart 0 nan 0\nreference_deg 90\n",
+               "not an anchor file of aerie-control");
+  refused_with("aerie-control anchor 1\nchannel NAV_STATE\nutime 600000000\nstart 0 0 0\n", "not an anchor file");
+  // Without a file configured, the reason says so.
+  opt.anchor_file = "";
+  LockStep none(opt, 0);
+  none.bus.publish("NAV_STATE", nav_state(none.now = 5'000, aerie::nav_state_t::OK, 2.0));
+  drain(none.bus);
+  EXPECT_NE(none.status.message().find("no anchor_file is configured"), std::string::npos) << none.status.message();
 }
