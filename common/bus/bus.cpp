@@ -28,10 +28,15 @@ void Subscription::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   }
 }
 
-void Subscription::note_seq(int64_t seq) {
+void Subscription::note_seq(const std::string& channel, int64_t seq) {
+  auto last = last_seq_.find(channel);
+  if (last == last_seq_.end()) {
+    if (last_seq_.size() < kSeqChannels) last_seq_.emplace(channel, seq);
+    return;
+  }
   // A seq at or below the last one is a restarted publisher or a replayed log: resynchronise.
-  if (last_seq_ >= 0 && seq > last_seq_ + 1) counters_.sequence_gaps += seq - last_seq_ - 1;
-  last_seq_ = seq;
+  if (last->second >= 0 && seq > last->second && seq - last->second > 1) counters_.sequence_gaps += seq - last->second - 1;
+  last->second = seq;
 }
 
 std::optional<int64_t> peek_utime(const uint8_t* data, size_t size) {

@@ -9,6 +9,7 @@
 #include <concepts>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -56,12 +57,15 @@ class Subscription {
   friend class Bus;
   void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   virtual void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) = 0;
-  void note_seq(int64_t seq);
+  // Sequence gaps are counted per channel: a pattern subscription (STATUS_.*) hears several
+  // publishers, each with its own seq. At most kSeqChannels channels are followed.
+  void note_seq(const std::string& channel, int64_t seq);
+  static constexpr size_t kSeqChannels = 256;
 
   std::string channel_;
   ChannelCounters counters_;
   std::string last_error_;
-  int64_t last_seq_ = -1;
+  std::map<std::string, int64_t> last_seq_;  // per channel heard
   lcm::Subscription* handle_ = nullptr;
   Bus* bus_ = nullptr;
 };
@@ -80,7 +84,7 @@ class TypedSubscription final : public Subscription {
  private:
   void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
     const Msg msg = decode_bounded<Msg>(rbuf->data, rbuf->data_size);  // throws std::invalid_argument
-    if constexpr (HasSeq<Msg>) note_seq(msg.seq);
+    if constexpr (HasSeq<Msg>) note_seq(channel, msg.seq);
     handler_(msg, ReceiveInfo{channel, rbuf->recv_utime, rbuf->data_size});
   }
   Handler handler_;

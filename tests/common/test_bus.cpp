@@ -2,6 +2,8 @@
 
 #include <aerie/pose_t.hpp>
 
+#include <cstdint>
+
 #include "common/bus/bus.hpp"
 #include "common/bus/status.hpp"
 #include "common/image/image_message.hpp"
@@ -25,6 +27,30 @@ TEST(Bus, TypedRoundTripOverMemq) {
   }
   EXPECT_EQ(got, (std::vector<int64_t>{0, 1, 2, 5}));
   EXPECT_EQ(bus.subscriptions()[0]->counters().sequence_gaps, 2);
+}
+
+TEST(Bus, SequenceGapsOfAPatternSubscriptionAreCountedPerChannel) {
+  // STATUS_.* hears every node's status, each with its own seq: interleaved, they are no gaps.
+  Bus bus("memq://");
+  bus.subscribe<aerie::pose_t>("POSE_.*", [](const aerie::pose_t&, const ReceiveInfo&) {});
+  const auto send = [&](const std::string& channel, int64_t seq) {
+    aerie::pose_t p{};
+    p.seq = seq;
+    bus.publish(channel, p);
+    while (bus.handle(0) > 0) {
+    }
+  };
+  for (int64_t k = 0; k < 5; ++k) {
+    send("POSE_A", k);
+    send("POSE_B", 1000 + k);
+  }
+  EXPECT_EQ(bus.subscriptions()[0]->counters().sequence_gaps, 0);
+  send("POSE_A", 8);                      // 5, 6, 7 lost on POSE_A
+  send("POSE_B", 1005);
+  send("POSE_B", INT64_MAX);              // a hostile seq: counted, no overflow
+  send("POSE_B", 0);                      // restarted: resynchronised
+  send("POSE_B", 1);
+  EXPECT_EQ(bus.subscriptions()[0]->counters().sequence_gaps, 3 + (INT64_MAX - 1005 - 1));
 }
 
 TEST(Bus, CorruptPayloadIsCountedNotDelivered) {
