@@ -1,4 +1,4 @@
-#include "ground/viewer/heap.hpp"
+#include "common/util/heap.hpp"
 
 #include <malloc.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <fstream>
 
-namespace aerie::viewer {
+namespace aerie::util {
 namespace {
 
 int64_t rss_kb() {
@@ -29,4 +29,4 @@ int64_t trim_heap() {
   return std::max<int64_t>(0, before - rss_kb());
 }
 
-}  // namespace aerie::viewer
+}  // namespace aerie::util

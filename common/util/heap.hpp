@@ -1,14 +1,13 @@
 #pragma once
-// The viewer's heap, as glibc's malloc sees it, and handing back what it holds free.
+// A process's heap, as glibc's malloc sees it, and handing back what it holds free.
 //
-// The viewer allocates in bursts on three threads (LCM handling, rendering, the map's
-// mesher): images, meshes, VTK arrays. glibc keeps what they free in its arenas, so the
-// process's RSS follows the highest burst so far rather than what is in use (the soak's
-// step-wise RSS growth, docs/results/soak.md). malloc_trim(3) returns the free pages of
-// every arena to the kernel.
+// glibc keeps what a process frees in its arenas, so after a burst (the viewer's images,
+// meshes and VTK arrays on three threads; the map's octree before a CLEAR) the RSS follows
+// the highest burst so far rather than what is in use: the soak's step-wise RSS growth
+// (docs/results/soak.md). malloc_trim(3) returns the free pages of every arena to the kernel.
 #include <cstdint>
 
-namespace aerie::viewer {
+namespace aerie::util {
 
 struct HeapFigures {
   int64_t in_use_kb = 0;  // allocated and not freed (mallinfo2: uordblks + hblkhd)
@@ -21,4 +20,4 @@ HeapFigures heap_figures();
 // malloc_trim(0); returns the resident memory it gave back (kB, RSS before minus after).
 int64_t trim_heap();
 
-}  // namespace aerie::viewer
+}  // namespace aerie::util

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/spherical/spherical_message.hpp"
+#include "common/util/heap.hpp"
 #include "common/util/time.hpp"
 #include "ground/map/octomap_message.hpp"
 
@@ -437,6 +438,9 @@ void MapService::on_cmd(const aerie::map_cmd_t& c, const bus::ReceiveInfo&) {
         map_.clear();
         unpublished_.reset();
         publications_ = 0;
+        // The octree's nodes are freed; hand their pages back (util/heap.hpp), or the RSS
+        // keeps the largest map so far.
+        status_.count("heap_released_kb", util::trim_heap());
         spdlog::info("map cleared");
         break;
       case aerie::map_cmd_t::PUBLISH_FULL:

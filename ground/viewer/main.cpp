@@ -54,6 +54,9 @@ int main(int argc, char** argv) {
   app.add_option("--multisamples", opts.multisamples, "OpenGL anti-aliasing samples (0: off, best without a GPU)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  app.add_option("--trajectory-poses", opts.trajectory_poses, "poses of each trajectory drawn (the newest)")
+      ->capture_default_str()
+      ->check(CLI::Range(size_t{1}, size_t{1000000}));
   app.add_option("--trim-period", opts.trim_period_s,
                  "hand the heap's free memory back to the kernel (malloc_trim) every this many seconds (0: never)")
       ->capture_default_str()

@@ -1,6 +1,5 @@
 #include "ground/viewer/viewer.hpp"
 
-#include "ground/viewer/heap.hpp"
 
 #include <spdlog/spdlog.h>
 #include <vtkCallbackCommand.h>
@@ -17,8 +16,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/bus/node.hpp"
+#include "common/util/heap.hpp"
 #include "common/util/time.hpp"
-#include "ground/viewer/heap.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -64,8 +63,8 @@ void Viewer::add_default_renderers() {
   add(std::make_unique<GtBoxOverlay>());
   add(std::make_unique<PilotOverlay>());
   add(std::make_unique<GridRenderer>());
-  add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false));
-  add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true));
+  add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false, options_.trajectory_poses));
+  add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true, options_.trajectory_poses));
   add(std::make_unique<DepthCloudRenderer>());
   add(std::make_unique<OctomapRenderer>("MAP_OCTOMAP", options_.map_max_quads));
   add(std::make_unique<TargetPoseRenderer>());
@@ -170,12 +169,12 @@ void Viewer::housekeeping() {
   const double now = util::mono_ms() / 1000.0;
   if (options_.trim_period_s > 0 && now - last_trim_s_ >= options_.trim_period_s) {
     status_.count("heap_trims");
-    status_.count("heap_released_kb", trim_heap());
+    status_.count("heap_released_kb", util::trim_heap());
     last_trim_s_ = now;
   }
   if (now - last_status_s_ < 1.0) return;
   last_status_s_ = now;
-  const HeapFigures heap = heap_figures();
+  const util::HeapFigures heap = util::heap_figures();
   status_.set("frames_rendered", frames_rendered_);
   status_.set("heap_in_use_kb", heap.in_use_kb);
   status_.set("heap_free_kb", heap.free_kb);

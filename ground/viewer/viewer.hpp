@@ -38,6 +38,9 @@ struct ViewerOptions {
   bool always_redraw = false;
   // OctoMap display: more quads than this and the map is shown one level coarser (0: no limit).
   size_t map_max_quads = 60000;
+  // Trajectories (VO_POSE, GT_POSE) show the newest this many poses: 6000 is 5 minutes at
+  // 20 Hz, and bounds their memory in a long session.
+  size_t trajectory_poses = 6000;
   // Freed memory that glibc's arenas hold is handed back to the kernel this often
   // (malloc_trim, ground/viewer/heap.hpp); 0: never.
   double trim_period_s = 10;

@@ -101,8 +101,10 @@ void GridRenderer::on_enabled(bool on) {
 }
 
 // ---------------------------------------------------------------- poses
-PoseRenderer::PoseRenderer(std::string name, std::string channel, bool ground_truth)
-    : Renderer(std::move(name)), channel_(std::move(channel)), gt_(ground_truth) {}
+PoseRenderer::PoseRenderer(std::string name, std::string channel, bool ground_truth, size_t max_poses)
+    : Renderer(std::move(name)), channel_(std::move(channel)), gt_(ground_truth), poses_(max_poses) {
+  if (max_poses == 0) throw std::invalid_argument("viewer: a trajectory needs at least one pose");
+}
 
 void PoseRenderer::subscribe(bus::Bus& bus) {
   if (gt_) {

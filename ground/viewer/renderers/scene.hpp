@@ -44,10 +44,11 @@ struct StampedPose {
 };
 
 // A pose stream (aerie.pose_t on VO_POSE, or aerie.gt_pose_t on GT_POSE): the
-// trajectory as a polyline and the camera frustum at the newest pose.
+// trajectory of the newest `max_poses` poses as a polyline and the camera frustum at the
+// newest pose.
 class PoseRenderer : public Renderer {
  public:
-  PoseRenderer(std::string name, std::string channel, bool ground_truth);
+  PoseRenderer(std::string name, std::string channel, bool ground_truth, size_t max_poses = 6000);
   void subscribe(bus::Bus& bus) override;
   void attach(Layout& layout) override;
   bool update() override;
@@ -60,7 +61,7 @@ class PoseRenderer : public Renderer {
  private:
   std::string channel_;
   bool gt_;
-  History<StampedPose> poses_{100000};
+  History<StampedPose> poses_;
   uint64_t seen_ = 0;
   size_t shown_ = 0;
   std::vector<StampedPose> buffer_;

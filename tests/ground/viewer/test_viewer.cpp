@@ -7,10 +7,8 @@
 #include <link.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <cstring>
 #include <map>
-#include <utility>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <thread>
@@ -30,7 +28,6 @@
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
-#include "ground/viewer/heap.hpp"
 #include "ground/viewer/viewer.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -450,25 +447,4 @@ TEST_F(Fixture, PublishesItsStatusWithTheHeapAndTrimsIt) {
 #endif
   EXPECT_GE(last["heap_trims"], 5);
   EXPECT_GE(last["heap_released_kb"], 0);
-}
-
-TEST(Heap, TrimHandsBackTheFreePagesAFragmentedHeapHolds) {
-#ifdef __SANITIZE_ADDRESS__
-  GTEST_SKIP() << "ASan's allocator replaces glibc's heap";
-#else
-  // 32 MB in 1 KB blocks, every 64th kept: free() can give none of it back (a block is
-  // live in every 64 KB), malloc_trim can give back the whole free pages between them.
-  std::vector<char*> blocks(32 * 1024);
-  for (auto& b : blocks) {
-    b = static_cast<char*>(std::malloc(1024));
-    std::memset(b, 1, 1024);
-  }
-  for (size_t i = 0; i < blocks.size(); ++i)
-    if (i % 64) std::free(std::exchange(blocks[i], nullptr));
-  const HeapFigures held = heap_figures();
-  EXPECT_GT(held.free_kb, 28 * 1024);
-  const int64_t released = trim_heap();
-  EXPECT_GT(released, 20 * 1024) << "free " << held.free_kb << " kB";
-  for (char* b : blocks) std::free(b);
-#endif
 }
