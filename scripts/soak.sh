@@ -3,6 +3,7 @@
 # again in real time by one long-running chain, its processes sampled once a second.
 #   bash scripts/soak.sh [--minutes N | --flights N] [--seed N] [--out DIR] [--warmup-minutes M]
 #                        [--netns] [--keep-log] [--bin DIR] [--recv-buf-size BYTES]
+#                        [--kill NODES] [--kill-window A:B]
 # One deputy and one logger (aerie-log record), aerie-map, aerie-viewer, aerie-vo and
 # aerie-track run the whole time; each flight restarts aerie-pilot (its mission ends LANDED)
 # and aerie-flightsim with the next seed (--seed, then +1 per flight), through a headless
@@ -18,6 +19,10 @@
 # away from any other LCM traffic of the host. Ctrl-C stops early and still summarises.
 # --recv-buf-size gives every node's LCM socket another receive buffer (recv_buf_size in
 # LCM_DEFAULT_URL; scripts/local-lcm.sh gives 4 MiB), to compare the drops.
+# --kill track,pilot,vo: a fault per flight, the nodes in turn: kill -9 of that air node at a
+# time drawn from the flight's seed in A:B seconds after the vehicle starts (--kill-window,
+# default 4:16); procman respawns it (auto_respawn, config/demo.pmd). flights.csv then says
+# which node died when, and how soon its new process ran (docs/faults.md).
 # Builds nothing when the binaries exist (else scripts/build.sh); --bin takes the nodes from
 # another build's bin/ (the suite's smoke test). Exit 0 when every flight landed within the
 # success bounds and the logger lost nothing.
@@ -27,7 +32,7 @@ caller_pwd="${AERIE_SOAK_PWD:-$PWD}"  # paths in the options are relative to it
 cd "$(dirname "$0")/.."
 args=("$@")
 
-minutes=30 flights=0 seed=1 out="" warmup=3 netns=0 keep_log=0 BIN="" recv_buf=""
+minutes=30 flights=0 seed=1 out="" warmup=3 netns=0 keep_log=0 BIN="" recv_buf="" kill_nodes=() kill_window=4:16
 number() { [[ "$2" =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "soak: $1 needs a number, not '$2'" >&2; exit 2; }; }
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -40,6 +45,14 @@ while [ $# -gt 0 ]; do
     --keep-log) keep_log=1; shift ;;
     --recv-buf-size) [[ "${2:-}" =~ ^[1-9][0-9]*$ ]] || { echo "soak: --recv-buf-size needs bytes" >&2; exit 2; }
                      recv_buf="$2"; shift 2 ;;
+    --kill) IFS=, read -r -a kill_nodes <<<"${2:-}"
+            [ ${#kill_nodes[@]} -gt 0 ] || { echo "soak: --kill needs air nodes (track, pilot, vo)" >&2; exit 2; }
+            for k in "${kill_nodes[@]}"; do
+              [[ "$k" =~ ^(track|pilot|vo)$ ]] || { echo "soak: --kill: '$k' is not an air node of config/demo.pmd (track, pilot, vo)" >&2; exit 2; }
+            done; shift 2 ;;
+    --kill-window) [[ "${2:-}" =~ ^[0-9]+([.][0-9]+)?:[0-9]+([.][0-9]+)?$ ]] && awk "BEGIN{split(\"$2\", w, \":\"); exit !(w[1] <= w[2])}" ||
+                     { echo "soak: --kill-window needs A:B seconds with A <= B, not '${2:-}'" >&2; exit 2; }
+                   kill_window="$2"; shift 2 ;;
     --bin) BIN="${2:-}"; [[ "$BIN" = /* ]] || BIN="$caller_pwd/$BIN"
            [ -d "$BIN" ] || { echo "soak: --bin needs a folder of binaries, not '${2:-}'" >&2; exit 2; }; shift 2 ;;
     -h|--help) awk 'NR > 1 && /^#/ {sub(/^# ?/, ""); print; next} NR > 1 {exit}' "$self"; exit 0 ;;
@@ -130,6 +143,32 @@ down_size=$(awk '/^down_camera:/ {s = 1; next} /^[^ #]/ {s = 0} s && $1 == "widt
                  END {print (w ? w : 376) "x" (h ? h : 240)}' config/sim/landing_room.yaml)
 
 deputy_pid="" monitor_pid="" sheriff_pid="" interrupted=0
+
+# --kill: waits for this flight's vehicle (an aerie-flightsim of the deputy other than
+# OLD_VEHICLE), kill -9s aerie-NODE AT seconds later and times until the deputy runs a new
+# one; writes "killed_pid,respawn_s" to FILE (empty fields: no vehicle, no node, no respawn).
+kill_during_flight() {  # NODE AT FILE OLD_VEHICLE
+  local node=$1 at=$2 file=$3 old=$4 sim="" victim="" new="" t_kill respawn=""
+  of_deputy() { pgrep -P "$deputy_pid" -x "$1" | head -n1 || true; }
+  for _ in $(seq 600); do
+    sim=$(of_deputy aerie-flightsim)
+    [ -n "$sim" ] && [ "$sim" != "$old" ] && break
+    sim=""; sleep 0.1
+  done
+  [ -n "$sim" ] || { echo "," >"$file"; return 0; }
+  sleep "$at"
+  victim=$(of_deputy "aerie-$node")
+  [ -n "$victim" ] || { echo "," >"$file"; return 0; }
+  kill -9 "$victim" 2>/dev/null || true
+  t_kill=$(date +%s.%N)
+  for _ in $(seq 200); do
+    new=$(of_deputy "aerie-$node")
+    [ -n "$new" ] && [ "$new" != "$victim" ] && break
+    new=""; sleep 0.05
+  done
+  [ -z "$new" ] || respawn=$(awk "BEGIN{printf \"%.2f\", $(date +%s.%N) - $t_kill}")
+  echo "$victim,$respawn" >"$file"
+}
 stop_chain() {
   if [ -n "$deputy_pid" ] && kill -0 "$deputy_pid" 2>/dev/null && [ "$interrupted" = 0 ]; then
     # In order (recorder last), then the deputy stops whatever still runs. (A Ctrl-C reached the
@@ -166,7 +205,7 @@ monitor_pid=$!
 load0=$(cut -d' ' -f1-3 /proc/loadavg)
 if [ "$flights" -gt 0 ]; then span="$flights flight(s)"; else span="$minutes min"; fi
 echo "soak: $span from seed $seed in real time (procman: config/demo.pmd); load average $load0; writing $out"
-echo "flight,seed,start_s,end_s,landed,success,touchdown_error_m,flight_time_s,result" >"$out/flights.csv"
+echo "flight,seed,start_s,end_s,landed,success,touchdown_error_m,flight_time_s,result,kill,kill_at_s,killed_pid,respawn_s" >"$out/flights.csv"
 t0=$(date +%s.%N)
 elapsed() { awk "BEGIN{printf \"%.3f\", $(date +%s.%N) - $t0}"; }
 
@@ -189,11 +228,25 @@ while [ "$interrupted" = 0 ]; do
   tag=$(printf "%04d" "$n")
   result="$out/flights/$tag-result.txt"
   flight_pmd "$s" "$result" >"$out/pmd/flight-$tag.pmd"
+  kill_node="" kill_at="" killer_pid=""
+  if [ ${#kill_nodes[@]} -gt 0 ]; then
+    kill_node=${kill_nodes[$(( (n - 1) % ${#kill_nodes[@]} ))]}
+    kill_at=$(awk -v s="$s" -v w="$kill_window" 'BEGIN{split(w, a, ":"); srand(s); printf "%.2f", a[1] + rand() * (a[2] - a[1])}')
+    kill_during_flight "$kill_node" "$kill_at" "$out/flights/$tag-kill.txt" \
+      "$(pgrep -P "$deputy_pid" -x aerie-flightsim | head -n1 || true)" &
+    killer_pid=$!
+  fi
   start=$(elapsed)
   status=0
   "$BIN/aerie-sheriff" "$out/pmd/flight-$tag.pmd" --script soak_flight --on-script-complete exit --no-table \
     --wait-timeout 300 >"$out/sheriff/flight-$tag.log" 2>&1 || status=$?
   end=$(elapsed)
+  kill_row=",,,"
+  if [ -n "$killer_pid" ]; then
+    kill "$killer_pid" 2>/dev/null || true  # a flight that ended before its fault
+    wait "$killer_pid" 2>/dev/null || true
+    kill_row="$kill_node,$kill_at,$(cat "$out/flights/$tag-kill.txt" 2>/dev/null || echo ",")"
+  fi
   [ -n "$monitor_pid" ] && kill -USR1 "$monitor_pid" 2>/dev/null || true  # tracker: STOP, re-arm the INIT
   deputy_gone=0
   kill -0 "$deputy_pid" 2>/dev/null || deputy_gone=1
@@ -211,8 +264,9 @@ while [ "$interrupted" = 0 ]; do
   [[ "$line" == "LANDED (success)"* ]] && is_success=1 && succeeded=$((succeeded + 1))
   [[ "$line" =~ touchdown\ error\ ([0-9.]+)\ m ]] && err="${BASH_REMATCH[1]}"
   [[ "$line" =~ after\ ([0-9.]+)\ s ]] && ftime="${BASH_REMATCH[1]}"
-  echo "$n,$s,$start,$end,$is_landed,$is_success,$err,$ftime,\"$line\"" >>"$out/flights.csv"
-  printf "soak: flight %d (seed %d) at %5.0f s: %s\n" "$n" "$s" "$start" "$line"
+  echo "$n,$s,$start,$end,$is_landed,$is_success,$err,$ftime,\"$line\",$kill_row" >>"$out/flights.csv"
+  printf "soak: flight %d (seed %d) at %5.0f s: %s%s\n" "$n" "$s" "$start" "$line" \
+    "${kill_node:+ (aerie-$kill_node killed at $kill_at s: $kill_row)}"
   if [ "$deputy_gone" = 1 ] && [ "$interrupted" = 0 ]; then
     echo "soak: the deputy has gone (see $out/deputy.log); stopping" >&2
     break

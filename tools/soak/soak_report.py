@@ -280,13 +280,37 @@ def main():
                  + (" (" + ", ".join(f"{c} {v}" for c, v in gaps.items()) + ")" if gaps else "")
                  + ". Operator commands sent between flights: "
                  + ", ".join(f"{k} {v}" for k, v in mon.get("track_cmd_sent", {}).items()) + ".\n")
+    faulted = [f for f in done if f.get("kill")]
+    if faulted:
+        # soak.sh --kill: one air node kill -9'd per flight, respawned by procman (issue 19 §4).
+        L.append("## Faults: an air node killed in flight (kill -9, procman's respawn)\n")
+        L.append("| node killed | flights | killed at (s after the vehicle's start) | respawned | respawn (s) mean / max "
+                 "| safe (no collision) | completed (landed within the bounds) | pilot HOLDs |")
+        L.append("|---|---|---|---|---|---|---|---|")
+        by_node = defaultdict(list)
+        for f in faulted:
+            by_node[f["kill"]].append(f)
+        summary["faults"] = {}
+        for node, fs in sorted(by_node.items()):
+            at = [float(f["kill_at_s"]) for f in fs]
+            killed = [f for f in fs if f.get("killed_pid")]
+            resp = [float(f["respawn_s"]) for f in killed if f.get("respawn_s")]
+            safe = sum("collision" not in f["result"] for f in fs)
+            completed = sum(f["success"] == "1" for f in fs)
+            summary["faults"][node] = {"flights": len(fs), "killed": len(killed), "respawned": len(resp), "safe": safe,
+                                       "completed": completed, "holds": sum(f["holds"] for f in fs)}
+            L.append(f"| aerie-{node} | {len(fs)} | {min(at):.1f}–{max(at):.1f} | {len(resp)} of {len(killed)} killed "
+                     f"| {fmt(sum(resp) / len(resp) if resp else math.nan, '.2f')} / {fmt(max(resp) if resp else math.nan, '.2f')} "
+                     f"| {safe}/{len(fs)} | {completed}/{len(fs)} | {sum(f['holds'] for f in fs)} |")
+        L.append("")
     L.append("## Flights\n")
     L.append("| flight | seed | start (s) | cycle (s) | operator INIT (s into the cycle) | pilot states | result |")
     L.append("|---|---|---|---|---|---|---|")
     for f in flights:
         states = " → ".join(dedupe(f["states"]))
         L.append(f"| {f['flight']} | {f['seed']} | {float(f['start_s']):.0f} | {float(f['end_s']) - float(f['start_s']):.1f} "
-                 f"| {fmt(f['init_s'])} | {states} | {f['result']} |")
+                 f"| {fmt(f['init_s'])} | {states} | {f['result']}"
+                 + (f" (aerie-{f['kill']} killed at {f['kill_at_s']} s)" if f.get("kill") else "") + " |")
     L.append("")
     if failures:
         L.append("Failed: " + ", ".join(f"flight {f['flight']} (seed {f['seed']})" for f in failures) + ".\n")

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Smoke test of scripts/soak.sh: one flight (--flights 1), in a private network namespace
-# (--netns), with the nodes of the build under test (--bin).
+# (--netns), with the nodes of the build under test (--bin), and a fault in it: aerie-track
+# killed with kill -9 in mid-flight (--kill track), which procman must respawn.
 #   soak_smoke.sh SOURCE_DIR BIN_DIR WORK_DIR
 # Passes when the soak ran to its summary: a finished flight's result line in flights.csv,
 # samples.csv with rows for every process of the chain, counters.csv with the STATUS_*
 # counters of every Aerie node, the logger's losses counted (log-info.json), soak.md with its
 # tables, and the plots when matplotlib is there. The landing itself is not required (a
 # loaded machine may miss frames; tests/integration/landing checks landings in lock-step),
-# but is printed. Exit 77 (skipped) without root, ip or Xvfb.
+# but is printed; the kill and the respawn are. Exit 77 (skipped) without root, ip or Xvfb.
 set -uo pipefail
 src="$1" bin="$2" work="$3"
 [ "$(id -u)" -eq 0 ] || { echo "SKIP: the soak's --netns needs root (ip netns add)"; exit 77; }
@@ -18,7 +19,7 @@ rm -rf "$work"
 mkdir -p "$(dirname "$work")"
 
 status=0
-bash "$src/scripts/soak.sh" --flights 1 --netns --warmup-minutes 0.1 --bin "$bin" --out "$work" >"$work.out" 2>&1 || status=$?
+bash "$src/scripts/soak.sh" --flights 1 --netns --warmup-minutes 0.1 --kill track --kill-window 6:8 --bin "$bin" --out "$work" >"$work.out" 2>&1 || status=$?
 cat "$work.out"
 fail=0
 check() {  # DESCRIPTION COMMAND...
@@ -31,6 +32,13 @@ for f in soak.md summary.json samples.csv counters.csv host.csv flights.csv log-
 done
 check "flights.csv has one finished flight" \
   awk -F, 'NR == 2 && $9 ~ /^"(LANDED|NOT LANDED)/ {ok = 1} END {exit !(ok && NR == 2)}' "$work/flights.csv"
+check "aerie-track was killed 6-8 s into the flight and respawned by the deputy" /usr/bin/python3 -c '
+import csv, sys
+f = next(csv.DictReader(open(sys.argv[1])))
+ok = f["kill"] == "track" and 6 <= float(f["kill_at_s"]) <= 8 and f["killed_pid"] and 0 < float(f["respawn_s"] or 0) < 5
+print("   kill:", f["kill"], "at", f["kill_at_s"], "s, pid", f["killed_pid"], "respawned after", f["respawn_s"], "s")
+sys.exit(not ok)' "$work/flights.csv"
+check "soak.md has the faults table" grep -q '^| aerie-track | 1 | ' "$work/soak.md"
 for node in flightsim pilot track vo map logger viewer deputy; do
   check "samples.csv has $node" awk -F, -v n="$node" '$3 == n && $5 > 0 {found = 1} END {exit !found}' "$work/samples.csv"
 done
