@@ -22,9 +22,10 @@ struct ControlConfig {
   double forward_speed_m_s = 0.0;     // forward speed commanded while active
   double stale_timeout_s = 0.5;       // no heading for longer than this -> fallback hover
   // A heading older than this when it arrives (its capture time against the node's clock)
-  // -> fallback hover; 0 = off. The delayed-link study (docs/results/linkstudy.md §4): from
-  // 200 ms the turn no longer settles, a gap-only timeout never fires behind a steady delay.
-  double max_input_age_s = 0.2;
+  // -> fallback hover; 0 = off. The delayed-link study (docs/results/linkstudy.md §4): the
+  // turn settles on headings 150 ms old, not on 200 ms; a gap-only timeout never fires
+  // behind a steady delay.
+  double max_input_age_s = 0.15;
   // > 0: the avoidance of thesis 5.1.2 — fly straight ahead (zero yaw rate) until the pose has
   // moved this far from the first one (the normal flight area), then turn to the reference.
   // 0: the reference applies from the first heading.

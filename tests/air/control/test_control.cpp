@@ -336,7 +336,7 @@ TEST(ControlConfig, RefusesTimeoutsAndRatesOutsideTheirRanges) {
   const auto shipped = node_setup(util::Config::load((test::source_dir() / "config" / "control.yaml").string()));
   EXPECT_EQ(shipped.options.message_time.max_jump_us, 10'000'000);
   EXPECT_EQ(shipped.options.message_time.resync_messages, 3);
-  EXPECT_EQ(shipped.options.control.max_input_age_s, 0.2);
+  EXPECT_EQ(shipped.options.control.max_input_age_s, 0.15);
   EXPECT_EQ(node_setup(util::Config::parse("max_input_age_s: 0\n", "c.yaml")).options.control.max_input_age_s, 0.0);
 }
 
@@ -447,7 +447,7 @@ TEST(ControlLoop, AnOldHeadingIsNotFlownOnAndHovers) {
   ControlConfig cfg;
   cfg.forward_speed_m_s = 0.6;
   cfg.activation_distance_m = 1.0;
-  ASSERT_EQ(cfg.max_input_age_s, 0.2);
+  ASSERT_EQ(cfg.max_input_age_s, 0.15);
   ASSERT_EQ(cfg.stale_timeout_s, 0.5);
   const Eigen::Vector3d start(0, 0, 0), far(2, 0, 0);
   // Only aged headings so far: no flight yet, a fallback hover (not "no input").
@@ -472,7 +472,7 @@ TEST(ControlLoop, AnOldHeadingIsNotFlownOnAndHovers) {
   EXPECT_EQ(old.forward_speed_m_s, 0.0);
   EXPECT_TRUE(loop.turning());
   // Exactly the limit is flown: the FLC goes on as if the old heading had never come.
-  ASSERT_TRUE(loop.on_heading(1'100'000, 40.0, 1'400'000, far, 0.2));
+  ASSERT_TRUE(loop.on_heading(1'100'000, 40.0, 1'400'000, far, 0.15));
   EXPECT_FALSE(loop.aged());
   ASSERT_TRUE(reference.on_heading(1'000'000, 10.0, 1'050'000, start, 0.0));
   ASSERT_TRUE(reference.on_heading(1'033'333, 10.0, 1'083'333, start, 0.0));
