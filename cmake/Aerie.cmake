@@ -50,7 +50,11 @@ function(aerie_test name)
   if(A_XVFB)
     find_program(XVFB_RUN xvfb-run REQUIRED)
     add_test(NAME ${name} COMMAND ${XVFB_RUN} -a $<TARGET_FILE:${name}>)
-    set_tests_properties(${name} PROPERTIES TIMEOUT ${A_TIMEOUT} RUN_SERIAL ${A_SERIAL} LABELS "${A_LABELS}")
+    # Two `xvfb-run -a` starting at once can both take display :99 and one's server then
+    # goes with the other's (test_viewer lost its X server that way under ctest -j2): every
+    # test that starts xvfb-run holds this lock.
+    set_tests_properties(${name} PROPERTIES TIMEOUT ${A_TIMEOUT} RUN_SERIAL ${A_SERIAL} LABELS "${A_LABELS}"
+                                            RESOURCE_LOCK xvfb-run)
   else()
     gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_LIST ${name}_TESTS)
     set(script ${CMAKE_CURRENT_BINARY_DIR}/${name}_properties.cmake)

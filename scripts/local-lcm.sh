@@ -34,7 +34,9 @@ aerie_local_lcm() {
 aerie_start_xvfb() {
   xvfb_pid=""
   if [ -z "${DISPLAY:-}" ]; then
-    export DISPLAY=:$((90 + RANDOM % 100))
+    local n=$((90 + RANDOM % 100))
+    while [ -e "/tmp/.X$n-lock" ]; do n=$((n + 1)); done  # a display no X server holds
+    export DISPLAY=:$n
     Xvfb "$DISPLAY" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
     xvfb_pid=$!
   fi
