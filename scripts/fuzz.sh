@@ -6,9 +6,10 @@ set -euo pipefail
 
 usage() {
   cat <<'EOF'
-usage: scripts/fuzz.sh [--seconds N] [--target NAME]... [--jobs J] [--no-build]
+usage: scripts/fuzz.sh [--seconds N] [--runs R] [--target NAME]... [--jobs J] [--no-build]
 
-  --seconds N    fuzzing time per target (default 600)
+  --seconds N    fuzzing time per target (default 600; with --runs, a ceiling)
+  --runs R       stop each target after R executions (libFuzzer's -runs) or N seconds
   --target NAME  run only this target (repeatable; default: every fuzz/targets/*.cpp)
   --jobs J       parallel compile jobs (default: nproc; use 1 on a shared machine)
   --no-build     run the targets already built in build/fuzz
@@ -26,6 +27,7 @@ EOF
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build/fuzz
 seconds=600
+runs=-1
 jobs=$(nproc)
 do_build=1
 targets=()
@@ -33,6 +35,7 @@ while [ $# -gt 0 ]; do
   case $1 in
     --seconds) seconds=${2:?--seconds needs a value}; shift 2 ;;
     --target) targets+=("${2:?--target needs a name}"); shift 2 ;;
+    --runs) runs=${2:?--runs needs a value}; shift 2 ;;
     --jobs) jobs=${2:?--jobs needs a value}; shift 2 ;;
     --no-build) do_build=0; shift ;;
     -h|--help) usage; exit 0 ;;
@@ -40,6 +43,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 [[ $seconds =~ ^[0-9]+$ && $seconds -gt 0 ]] || { echo "fuzz.sh: --seconds must be a positive integer" >&2; exit 2; }
+[[ $runs = -1 || ( $runs =~ ^[0-9]+$ && $runs -gt 0 ) ]] || { echo "fuzz.sh: --runs must be a positive integer" >&2; exit 2; }
 if [ ${#targets[@]} -eq 0 ]; then
   for f in "$root"/fuzz/targets/*.cpp; do targets+=("$(basename "$f" .cpp)"); done
 fi
@@ -96,9 +100,9 @@ for t in "${targets[@]}"; do
   corpora=("$work" "$root/fuzz/corpus/$t")
   [ -d "$root/fuzz/regressions/$t" ] && corpora+=("$root/fuzz/regressions/$t")
   before=$(crashes_in "$artifacts")
-  echo "== $t: ${seconds} s"
+  echo "== $t: ${seconds} s$([ "$runs" = -1 ] || echo " or $runs executions")"
   set +e
-  "$bin" -max_total_time="$seconds" -max_len="$(max_len "$t")" -detect_leaks="$(detect_leaks "$t")" \
+  "$bin" -max_total_time="$seconds" -runs="$runs" -max_len="$(max_len "$t")" -detect_leaks="$(detect_leaks "$t")" \
     -timeout=25 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/" "${corpora[@]}" >"$log" 2>&1
   rc=$?
   set -e
