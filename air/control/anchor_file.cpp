@@ -1,7 +1,6 @@
 #include "air/control/anchor_file.hpp"
 
 #include <cmath>
-#include <filesystem>
 #include <sstream>
 
 #include "common/util/files.hpp"
@@ -21,11 +20,6 @@ void write_anchor(const std::string& path, const std::string& channel, const Anc
 }
 
 std::optional<Anchor> read_anchor(const std::string& path, const std::string& channel, std::string& why) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) {
-    why = path + ": no anchor kept";
-    return std::nullopt;
-  }
   std::string text;
   try {
     text = util::read_regular_file(path, "anchor file");

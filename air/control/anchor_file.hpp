@@ -16,8 +16,8 @@ namespace aerie::control {
 
 void write_anchor(const std::string& path, const std::string& channel, const Anchor& anchor);  // throws
 
-// The anchor in `path` if it is one of `channel`'s; nullopt with the reason in `why` if there
-// is none, or it is malformed, or of another channel.
+// The anchor in `path` if it is one of `channel`'s; nullopt with the reason in `why` if the
+// file is missing (util::read_regular_file's message), malformed, or of another channel.
 std::optional<Anchor> read_anchor(const std::string& path, const std::string& channel, std::string& why);
 
 }  // namespace aerie::control

@@ -221,8 +221,8 @@ std::string ControlNode::resume_anchor(int64_t utime) {
   std::string why;
   std::optional<Anchor> a = read_anchor(opt_.anchor_file, opt_.pose_channel, why);
   if (a && !(a->utime < utime && static_cast<double>(utime) - static_cast<double>(a->utime) <= kMaxAnchorAgeUs)) {
-    why = opt_.anchor_file + ": its anchor (utime " + std::to_string(a->utime) +
-          ") is not from the 10 minutes before this pose (another mission or another clock)";
+    why = opt_.anchor_file + ": its anchor (utime " + std::to_string(a->utime) + ") is not from the " +
+          std::to_string(kMaxAnchorAgeUs / 60'000'000) + " minutes before this pose (another mission or another clock)";
     a.reset();
   }
   if (!a) return why;

@@ -1,6 +1,5 @@
 #include "ground/viewer/viewer.hpp"
 
-
 #include <spdlog/spdlog.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>

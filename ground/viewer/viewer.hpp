@@ -42,7 +42,7 @@ struct ViewerOptions {
   // 20 Hz, and bounds their memory in a long session.
   size_t trajectory_poses = 6000;
   // Freed memory that glibc's arenas hold is handed back to the kernel this often
-  // (malloc_trim, ground/viewer/heap.hpp); 0: never.
+  // (util::trim_heap, common/util/heap.hpp); 0: never.
   double trim_period_s = 10;
   std::string image_channel = "CAM_LEFT";
   std::string track_cmd_channel = "TRACK_CMD";
@@ -98,7 +98,7 @@ class Viewer {
   // Chooses the panes due for drawing (vtkRenderer::SetDraw); false when none is.
   bool schedule_panes(bool image_changed, const std::vector<vtkRenderer*>& changed);
   void update_help_text();
-  // Once a second: STATUS_VIEWER with the frames drawn and the heap (heap.hpp); the heap trim.
+  // Once a second: STATUS_VIEWER with the frames drawn and the heap (util::heap_figures); the heap trim.
   void housekeeping();
 
   bus::Bus& bus_;
