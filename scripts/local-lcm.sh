@@ -24,10 +24,13 @@ aerie_local_lcm() {
   # lcm-logger and the nodes need large socket buffers: stereo frames arrive as bursts of
   # fragments that overflow the kernel default (docs/logs.md).
   local rmem_max
-  rmem_max=$(sysctl -n net.core.rmem_max 2>/dev/null || echo 0)
+  rmem_max=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 0)  # no sysctl: procps may be absent
   if [ "$rmem_max" -lt 4194304 ] && [ "$(id -u)" -eq 0 ]; then
-    sysctl -q -w net.core.rmem_max=4194304
-    echo "$tag: raised net.core.rmem_max from $rmem_max to 4194304 (UDP receive buffers for images)"
+    if echo 4194304 2>/dev/null >/proc/sys/net/core/rmem_max; then
+      echo "$tag: raised net.core.rmem_max from $rmem_max to 4194304 (UDP receive buffers for images)"
+    else
+      echo "$tag: could not raise net.core.rmem_max from $rmem_max (read-only /proc/sys?): large images may be dropped" >&2
+    fi
   fi
 }
 

@@ -144,21 +144,32 @@ down_size=$(awk '/^down_camera:/ {s = 1; next} /^[^ #]/ {s = 0} s && $1 == "widt
 
 deputy_pid="" monitor_pid="" sheriff_pid="" interrupted=0
 
+# of_deputy NAME: the pid of the deputy's child named NAME, from /proc (procps is not a
+# dependency of Aerie: a fresh Debian 12 may have no pgrep).
+of_deputy() {
+  local comm stat ppid d
+  for d in /proc/[0-9]*; do  # read builtins, no fork per process
+    read -r comm 2>/dev/null <"$d/comm" && [ "$comm" = "$1" ] || continue
+    read -r stat 2>/dev/null <"$d/stat" || continue
+    read -r _ ppid _ <<<"${stat##*) }"  # "state ppid ...", after the name whatever it holds
+    [ "$ppid" = "$deputy_pid" ] && { echo "${d#/proc/}"; return 0; }
+  done
+  return 0
+}
 # --kill: waits for this flight's vehicle (an aerie-flightsim of the deputy other than
 # OLD_VEHICLE), kill -9s aerie-NODE AT seconds later and times until the deputy runs a new
 # one; writes "killed_pid,respawn_s" to FILE (empty fields: no vehicle, no node, no respawn).
 kill_during_flight() {  # NODE AT FILE OLD_VEHICLE
   local node=$1 at=$2 file=$3 old=$4 sim="" victim="" new="" t_kill respawn=""
-  of_deputy() { pgrep -P "$deputy_pid" -x "$1" | head -n1 || true; }
   for _ in $(seq 600); do
     sim=$(of_deputy aerie-flightsim)
     [ -n "$sim" ] && [ "$sim" != "$old" ] && break
     sim=""; sleep 0.1
   done
-  [ -n "$sim" ] || { echo "," >"$file"; return 0; }
+  [ -n "$sim" ] || { echo "soak: --kill: the deputy ran no new aerie-flightsim within 60 s" >&2; echo "," >"$file"; return 0; }
   sleep "$at"
   victim=$(of_deputy "aerie-$node")
-  [ -n "$victim" ] || { echo "," >"$file"; return 0; }
+  [ -n "$victim" ] || { echo "soak: --kill: the deputy runs no aerie-$node at $at s" >&2; echo "," >"$file"; return 0; }
   kill -9 "$victim" 2>/dev/null || true
   t_kill=$(date +%s.%N)
   for _ in $(seq 200); do
@@ -233,7 +244,7 @@ while [ "$interrupted" = 0 ]; do
     kill_node=${kill_nodes[$(( (n - 1) % ${#kill_nodes[@]} ))]}
     kill_at=$(awk -v s="$s" -v w="$kill_window" 'BEGIN{split(w, a, ":"); srand(s); printf "%.2f", a[1] + rand() * (a[2] - a[1])}')
     kill_during_flight "$kill_node" "$kill_at" "$out/flights/$tag-kill.txt" \
-      "$(pgrep -P "$deputy_pid" -x aerie-flightsim | head -n1 || true)" &
+      "$(of_deputy aerie-flightsim)" &
     killer_pid=$!
   fi
   start=$(elapsed)

@@ -12,7 +12,7 @@ LOGGER_URL=${3:-$RECV_URL}
 mkdir -p "$OUT"
 make_namespace aerie-bench-log
 LOG=$OUT/logger-loss.lcm
-echo "# $(machine_note); rmem_max $(sysctl -n net.core.rmem_max); logger URL $LOGGER_URL" | tee "$OUT/logger-loss-machine.txt"
+echo "# $(machine_note); rmem_max $(cat /proc/sys/net/core/rmem_max); logger URL $LOGGER_URL" | tee "$OUT/logger-loss-machine.txt"
 ip netns exec "$NS" lcm-logger -f --quiet --lcm-url="$LOGGER_URL" "$LOG" &
 logger=$!
 sleep 1
