@@ -210,6 +210,31 @@ void Eskf::initialise(const NominalState& x, const Mat15& P, const ImuSample& fi
   history_.push_back(Checkpoint{first, x_, P_, anchor_, last_update_utime_});
 }
 
+void Eskf::resume(const Snapshot& s, const ImuSample& first, const GapNoise& gap) {
+  const double dt = static_cast<double>(first.utime - s.x.utime) * 1e-6;
+  if (!(dt >= 0.0)) throw std::invalid_argument("the IMU sample to resume at is before the snapshot");
+  NominalState x = s.x;
+  x.p += x.v * dt;
+  x.q = (x.q * ExpQ((first.gyro - x.bg) * dt)).normalized();
+  // A constant unknown acceleration a ~ N(0, sa^2 I) over dt adds a dt^2/2 to p and a dt to v;
+  // a constant unknown rate w ~ N(0, sw^2 I) adds w dt to the attitude error.
+  const double sa2 = gap.accel_sigma_m_s2 * gap.accel_sigma_m_s2, sw2 = gap.rate_sigma_rad_s * gap.rate_sigma_rad_s;
+  Mat15 F = Mat15::Identity();  // the coasting's Jacobian: dp += dv dt
+  F.block<3, 3>(kP, kV) = dt * Mat3::Identity();
+  Mat15 P = F * s.P * F.transpose();
+  P.block<3, 3>(kP, kP) += sa2 * std::pow(dt, 4) / 4.0 * Mat3::Identity();
+  P.block<3, 3>(kP, kV) += sa2 * std::pow(dt, 3) / 2.0 * Mat3::Identity();
+  P.block<3, 3>(kV, kP) += sa2 * std::pow(dt, 3) / 2.0 * Mat3::Identity();
+  P.block<3, 3>(kV, kV) += sa2 * dt * dt * Mat3::Identity();
+  P.block<3, 3>(kTheta, kTheta) += sw2 * dt * dt * Mat3::Identity();
+  initialise(x, P, first);
+  anchor_ = s.T_world_vo;
+  last_update_utime_ = s.last_update_utime;
+  history_.back().anchor = anchor_;
+  history_.back().last_update_utime = last_update_utime_;
+  ++counters_.resumed;
+}
+
 // Propagation from sample a to sample b (b may be an interpolated sample). The nominal state
 // follows [S eq. 260] integrated with the mean of the two samples (midpoint / trapezoid, second
 // order); the error covariance P <- F P F^T + Q with F of [S eq. 269] and the noise of
@@ -459,7 +484,9 @@ std::string Eskf::status_reason() const {
                                                : "");
   }
   const double age = time_since_update_s();
-  if (counters_.vo_applied == 0 && status() == NavStatus::Ok) return "aligned " + fmt(age, 2) + " s ago, no VO update yet";
+  if (counters_.vo_applied == 0 && status() == NavStatus::Ok)
+    return counters_.resumed ? "resumed from a snapshot, last VO update " + fmt(age, 2) + " s ago"
+                             : "aligned " + fmt(age, 2) + " s ago, no VO update yet";
   switch (status()) {
     case NavStatus::Ok: return "last VO update " + fmt(age, 2) + " s ago";
     case NavStatus::ImuOnly: return "no VO update for " + fmt(age, 2) + " s: IMU only";

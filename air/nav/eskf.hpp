@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -124,6 +125,23 @@ struct EskfCounters {
   int64_t vo_invalid = 0, vo_too_old = 0, vo_duplicate = 0, vo_before_alignment = 0, vo_pending_dropped = 0;
   int64_t vo_delayed = 0;      // poses older than the newest IMU sample (re-propagation needed)
   int64_t vo_out_of_order = 0; // poses older than an already received VO pose
+  int64_t resumed = 0;         // starts from a snapshot (resume) instead of the alignment
+};
+
+// What a restarted filter resumes from (aerie-nav's state file): the nominal state, its
+// covariance, the VO frame's anchor T_world_vo and the time of the last applied update.
+struct Snapshot {
+  NominalState x;
+  Mat15 P = Mat15::Zero();
+  std::optional<geometry::SE3> T_world_vo;
+  int64_t last_update_utime = 0;
+};
+
+// The growth of the uncertainty over a gap the filter did not see (the restart): an unknown
+// acceleration and turn rate, each constant over the gap with these sigmas per axis.
+struct GapNoise {
+  double accel_sigma_m_s2 = 3.0;
+  double rate_sigma_rad_s = 30.0 * std::numbers::pi / 180.0;
 };
 
 // Result of the static alignment.
@@ -150,6 +168,12 @@ class Eskf {
   // Starts from a known state instead of the static alignment (tests, a known start); the
   // sample becomes the first of the buffer.
   void initialise(const NominalState& x, const Mat15& P, const ImuSample& first);
+  // Starts from a snapshot taken before a restart, without the static alignment and in the
+  // same world frame (the VO's anchor kept): the state coasted over the gap to `first` (the
+  // position at the snapshot's velocity, the attitude at first's bias-corrected rate), the
+  // covariance grown by `gap`. Throws std::invalid_argument when `first` is before the snapshot.
+  void resume(const Snapshot& s, const ImuSample& first, const GapNoise& gap);
+  Snapshot snapshot() const { return Snapshot{x_, P_, anchor_, last_update_utime_}; }
 
   bool initialised() const { return !history_.empty(); }
   NavStatus status() const;

@@ -52,6 +52,7 @@ NavConfig load_nav_config(const util::Config& cfg) {
       .known("vo")
       .known("outage")
       .known("message_time")
+      .known("resume")
       .finish();
   out.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), out.message_time);
   e.gravity_m_s2 = top.gravity_m_s2;
@@ -118,6 +119,21 @@ NavConfig load_nav_config(const util::Config& cfg) {
   e.gate_chi2 = v.gate_chi2;
   if (vo.has("T_world_vo"))
     e.T_world_vo = se3_from_row_major(vo.get<std::vector<double>>("T_world_vo", {}), cfg.origin() + ": vo.T_world_vo");
+
+  const util::Config rs = cfg.section("resume");
+  util::SectionReader<None>(rs, none)
+      .known("state_file")
+      .known("write_period_s")
+      .known("max_age_s")
+      .known("gap_accel_sigma_m_s2")
+      .known("gap_rate_sigma_deg_s")
+      .finish();
+  NavConfig::Resume& r = out.resume;
+  r.state_file = rs.get<std::string>("state_file", r.state_file);
+  r.write_period_s = rs.get_in("write_period_s", r.write_period_s, 1e-3, 60.0);
+  r.max_age_s = rs.get_in("max_age_s", r.max_age_s, 0.0, 60.0);
+  r.gap.accel_sigma_m_s2 = rs.get_in("gap_accel_sigma_m_s2", r.gap.accel_sigma_m_s2, 0.0, 100.0);
+  r.gap.rate_sigma_rad_s = rs.get_in("gap_rate_sigma_deg_s", r.gap.rate_sigma_rad_s / kDeg, 0.0, 3600.0) * kDeg;
 
   util::SectionReader<EskfParams>(cfg.section("outage"), e)("imu_only_after_s", &EskfParams::imu_only_after_s)(
       "lost_after_s", &EskfParams::lost_after_s)

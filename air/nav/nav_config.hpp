@@ -19,6 +19,13 @@ struct NavConfig {
   // The IMU's own bound (imu.max_jump_s), tighter: it comes at 200 Hz, and a bit-flipped
   // stamp 0.9 s ahead, within the 1 s above, moved the filter's clock and lost the VO.
   int64_t imu_max_jump_us = 200'000;
+  // Resuming after a restart in flight (resume.*; air/nav/state_file.hpp).
+  struct Resume {
+    std::string state_file;        // "" = none: a restarted aerie-nav aligns again (a new frame)
+    double write_period_s = 0.1;   // message time between two snapshots written
+    double max_age_s = 2.0;        // a snapshot older than this at the first IMU sample is not resumed from
+    GapNoise gap;
+  } resume;
 };
 
 NavConfig load_nav_config(const util::Config& cfg);

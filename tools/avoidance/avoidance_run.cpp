@@ -25,18 +25,18 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 double wrap180(double a) { return std::remainder(a, 360.0); }
 
-// aerie-control's anchor file for one flight (control_node.hpp: anchor_file), as the vehicle
-// keeps it on its disk, so that a respawned aerie-control resumes the manoeuvre; one per
-// flight (flights run in parallel), removed with it.
-struct FlightAnchorFile {
+// A file the vehicle keeps on its disk for one flight (aerie-control's anchor, aerie-nav's
+// snapshot), so that a respawned node resumes from it; one per flight and node (flights run in
+// parallel), removed with the flight.
+struct FlightFile {
   std::string path;
-  FlightAnchorFile() {
+  explicit FlightFile(const std::string& suffix) {
     static std::atomic<int64_t> next{0};
     path = (std::filesystem::temp_directory_path() /
-            ("aerie-avoidance-" + std::to_string(::getpid()) + "-" + std::to_string(next++) + ".anchor"))
+            ("aerie-avoidance-" + std::to_string(::getpid()) + "-" + std::to_string(next++) + "." + suffix))
                .string();
   }
-  ~FlightAnchorFile() {
+  ~FlightFile() {
     std::error_code ignored;
     std::filesystem::remove(path, ignored);
   }
@@ -133,7 +133,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     case Source::kVio: co.input = control::NodeOptions::Input::kNavState; break;
   }
   co.pose_channel = control::default_pose_channel(co.input);
-  const FlightAnchorFile anchor_file;
+  const FlightFile anchor_file("anchor"), nav_state_file("nav-state");
   co.anchor_file = anchor_file.path;
   co.frame = control::default_heading_frame(co.input);
   if (config.source != Source::kGt) {
@@ -149,8 +149,10 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     co.frame.up = R_body_cam.transpose() * Eigen::Vector3d::UnitZ();
     co.frame.forward = R_body_cam.transpose() * Eigen::Vector3d::UnitX();
   }
+  nav::NavConfig nc = config.nav;
+  nc.resume.state_file = nav_state_file.path;
   if (config.source == Source::kVio)
-    nav_node.emplace(nav_bus, [&] { return std::make_unique<nav::NavNode>(nav_bus, config.nav); });
+    nav_node.emplace(nav_bus, [&] { return std::make_unique<nav::NavNode>(nav_bus, nc); });
   faults::Respawnable<control::ControlNode> control_node(
       control_bus, [&] { return std::make_unique<control::ControlNode>(control_bus, control_status, config.controller, co, now); });
   faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }};

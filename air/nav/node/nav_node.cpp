@@ -6,6 +6,9 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <utility>
+
+#include "air/nav/state_file.hpp"
 
 namespace aerie::nav {
 namespace {
@@ -30,13 +33,18 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
       imu_time_(opt_.imu_channel, util::MessageClockConfig{cfg_.imu_max_jump_us, cfg_.message_time.resync_messages,
                                                            cfg_.message_time.stale_timeout_us}),
       vo_time_(opt_.vo_channel, cfg_.message_time) {
+  if (!cfg_.resume.state_file.empty()) {
+    std::string why;
+    resume_from_ = read_snapshot(cfg_.resume.state_file, why);
+    if (!resume_from_) spdlog::info("no state to resume from: {}; a static alignment starts the filter", why);
+  }
   bus_.subscribe<aerie::imu_t>(opt_.imu_channel, [this](const aerie::imu_t& m, const bus::ReceiveInfo&) {
     if (!admit(imu_time_, opt_.imu_channel, m.utime)) return;
     ImuSample s;
     s.utime = m.utime;
     s.gyro = Vec3(m.angular_velocity[0], m.angular_velocity[1], m.angular_velocity[2]);
     s.accel = Vec3(m.linear_acceleration[0], m.linear_acceleration[1], m.linear_acceleration[2]);
-    const Outcome o = eskf_.add_imu(s);
+    const Outcome o = resume_at(s) ? Outcome{true, ""} : eskf_.add_imu(s);
     if (!o.accepted) {
       ++counters_["imu_refused"];
       refused(opt_.imu_channel, o.reason);
@@ -50,6 +58,7 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
     const int64_t period_us =
         cfg_.publish_rate_hz > 0.0 ? static_cast<int64_t>(std::llround(1e6 / cfg_.publish_rate_hz)) : 0;
     if (last_publish_utime_ == INT64_MIN || m.utime - last_publish_utime_ >= period_us) publish();
+    keep_snapshot();
   }, 1000);  // 200 Hz: a deep queue so that a burst is not dropped
   bus_.subscribe<aerie::pose_t>(opt_.vo_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
     if (m.status == aerie::pose_t::LOST) {  // the pose is the last good one, not a measurement
@@ -89,6 +98,40 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
     }
     ++counters_["vo"];
   });
+}
+
+bool NavNode::resume_at(const ImuSample& first) {
+  if (!resume_from_ || eskf_.initialised()) return false;
+  const Snapshot snap = *std::exchange(resume_from_, std::nullopt);
+  const double age_s = static_cast<double>(first.utime - snap.x.utime) * 1e-6;
+  if (!(age_s >= 0.0 && age_s <= cfg_.resume.max_age_s)) {
+    spdlog::info("not resuming from {}: its state is {:.3f} s from the first IMU sample (resume.max_age_s {}; "
+                 "another flight or clock); a static alignment starts the filter",
+                 cfg_.resume.state_file, age_s, cfg_.resume.max_age_s);
+    return false;
+  }
+  eskf_.resume(snap, first, cfg_.resume.gap);
+  spdlog::info("resumed from {} ({:.3f} s old, VO frame {}): p = ({:.2f}, {:.2f}, {:.2f})", cfg_.resume.state_file,
+               age_s, snap.T_world_vo ? "anchored" : "not anchored yet", eskf_.state().p.x(), eskf_.state().p.y(),
+               eskf_.state().p.z());
+  last_status_ = eskf_.status();  // no INITIALISING -> OK to log: the filter did not initialise
+  return true;
+}
+
+void NavNode::keep_snapshot() {
+  if (cfg_.resume.state_file.empty() || !eskf_.initialised()) return;
+  const int64_t utime = eskf_.state().utime;
+  if (last_snapshot_utime_ != INT64_MIN &&
+      utime - last_snapshot_utime_ < static_cast<int64_t>(std::llround(cfg_.resume.write_period_s * 1e6)))
+    return;
+  last_snapshot_utime_ = utime;
+  try {
+    write_snapshot(cfg_.resume.state_file, eskf_.snapshot());
+    ++counters_["snapshots"];
+  } catch (const std::exception& e) {
+    ++counters_["snapshot_errors"];
+    refused("resume.state_file", e.what());
+  }
 }
 
 std::optional<util::MessageClock::Verdict> NavNode::admit(util::MessageClock& clock, const std::string& channel,
@@ -177,6 +220,7 @@ void NavNode::report(bus::StatusReporter& status) const {
   status.set("vo_pending_dropped", c.vo_pending_dropped);
   status.set("vo_delayed", c.vo_delayed);
   status.set("vo_out_of_order", c.vo_out_of_order);
+  status.set("resumed", c.resumed);
   const NavStatus s = eskf_.status();
   const std::string msg = std::string(to_string(s)) + ": " + eskf_.status_reason();
   if (s == NavStatus::Lost)

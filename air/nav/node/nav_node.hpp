@@ -1,6 +1,8 @@
 #pragma once
 // aerie-nav as a class: IMU (aerie.imu_t) and VO_POSE (aerie.pose_t) in, NAV_STATE
 // (aerie.nav_state_t) out, one per accepted IMU sample or at publish_rate_hz (message time).
+// With resume.state_file, the filter's snapshot is kept on disk and a restarted node resumes
+// from it in the same world frame.
 // Bad messages are refused by the filter or here with a reason, counted and logged; the
 // filter never sees a malformed one.
 #include <cstdint>
@@ -32,6 +34,10 @@ class NavNode {
 
  private:
   void publish();
+  // resume.state_file: true when the filter started from the snapshot read at construction
+  // (at `first`, the first IMU sample); the snapshot is used or dropped at the first sample.
+  bool resume_at(const ImuSample& first);
+  void keep_snapshot();
   void refused(const std::string& what, const std::string& why);
   // The message-time policy (NavConfig::message_time): nullopt, counted and logged, for a held
   // stamp; else the verdict (kResynced: the source restarted or came back after an outage).
@@ -48,6 +54,8 @@ class NavNode {
   NavStatus last_status_ = NavStatus::Initialising;
   int64_t seq_ = 0;
   int64_t last_publish_utime_ = INT64_MIN;
+  std::optional<Snapshot> resume_from_;  // read from resume.state_file at construction
+  int64_t last_snapshot_utime_ = INT64_MIN;
 };
 
 }  // namespace aerie::nav

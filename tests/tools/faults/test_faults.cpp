@@ -206,23 +206,22 @@ TEST(FaultsInFlight, TheAvoidanceFlightCompletesThroughAVoRestartAndABurst) {
       std::invalid_argument);
 }
 
-TEST(FaultsInFlight, AvoidanceResumesAfterAControlRestartAndHoversWhenANavRestartLosesTheFrame) {
+TEST(FaultsInFlight, AvoidanceCompletesThroughAControlOrANavRestart) {
   // A respawned aerie-control re-anchored the manoeuvre where it was and a respawned aerie-nav
-  // starts a new frame: both flew into the wall before aerie-control refused them. Now the
-  // respawned aerie-control takes the anchor up from its file and completes the turn; after
-  // aerie-nav's restart the frame is gone and it still hovers.
+  // started a new frame: both flew into the wall, then hovered once aerie-control refused them.
+  // Now the respawned aerie-control takes the anchor up from its file and the respawned
+  // aerie-nav resumes in its frame from its state file: the turn is completed through either.
   avoidance::RunConfig rc =
       avoidance::load_run_config(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
   rc.controller = flc::load_controller(AERIE_SOURCE_DIR "/config/flc/sfmf.yaml");
   rc.sim.max_time_s = 20;
   for (const char* fault : {"kill:control@5+1", "kill:nav@6+1"}) {
-    const bool control = std::string(fault).starts_with("kill:control");
     rc.faults = faults::parse_list(fault);
     const avoidance::RunResult r = avoidance::fly(rc, 1);
     EXPECT_FALSE(r.collided) << fault << ": " << r.collision;
     EXPECT_FALSE(r.entered_danger) << fault;
-    EXPECT_EQ(r.completed, control) << fault;
-    if (!control) EXPECT_GT(r.commands_fallback, 100) << fault;  // hovering from the restart to the time limit
+    EXPECT_TRUE(r.completed) << fault;
+    EXPECT_LT(r.heading_rmse_deg, 2.0) << fault;  // settled along the wall (0.93 deg without a fault)
   }
 }
 
