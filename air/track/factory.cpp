@@ -208,6 +208,12 @@ std::unique_ptr<Tracker> make_eco(const util::Config& cfg) {
   in.read_in("newton_iterations", p.newton_iterations, 0, 50);
   in.read("lost_confidence", p.lost_confidence);
   in.read_in("lost_after", p.lost_after, 1, 1000);
+  in.read("verify_threshold", p.verify_threshold);
+  in.read_in("verify_after", p.verify_after, 1, 1000);
+  in.read_in("verify_exemplars", p.verify_exemplars, 1, 100);
+  in.read("verify_learn_confidence", p.verify_learn_confidence);
+  in.read("verify_learn_similarity", p.verify_learn_similarity);
+  in.read_in("verify_interval", p.verify_interval, 1, 100000);
   in.read_in("global_interval", p.global_interval, 0, 100000);
   in.read_in("global_pixels", p.global_pixels, 1024.0, 4194304.0);
   in.read_in("global_candidates", p.global_candidates, 1, 20);

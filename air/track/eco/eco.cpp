@@ -58,6 +58,12 @@ void EcoParams::validate() const {
   require(newton_iterations >= 0, "newton_iterations must be >= 0");
   require(lost_confidence >= 0 && lost_confidence <= 1, "lost_confidence must be in [0, 1]");
   require(lost_after >= 1, "lost_after must be >= 1");
+  require(verify_threshold >= 0 && verify_threshold <= 1, "verify_threshold must be in [0, 1]");
+  require(verify_after >= 1, "verify_after must be >= 1");
+  require(verify_exemplars >= 1 && verify_exemplars <= 100, "verify_exemplars must be in [1, 100]");
+  require(verify_learn_confidence >= 0 && verify_learn_confidence <= 1, "verify_learn_confidence must be in [0, 1]");
+  require(verify_learn_similarity >= -1 && verify_learn_similarity <= 1, "verify_learn_similarity must be in [-1, 1]");
+  require(verify_interval >= 1, "verify_interval must be >= 1");
   require(global_interval >= 0, "global_interval must be >= 0");
   require(global_pixels >= 1024, "global_pixels must be >= 1024");
   require(global_candidates >= 1, "global_candidates must be >= 1");
@@ -172,6 +178,13 @@ void EcoTracker::train() {
   since_training_ = 0;
 }
 
+cv::Mat EcoTracker::verifier_patch(const cv::Mat& window_patch, cv::Point2d offset, double model_per_px) const {
+  const cv::Point2d centre = cv::Point2d(window_patch.cols / 2.0, window_patch.rows / 2.0) + offset * model_per_px;
+  const cv::Size2d box = target_ * (scale_ * model_per_px * AppearanceVerifier::kGrowth);
+  const int n = AppearanceVerifier::kPatch;
+  return to_gray(subwindow(window_patch, centre, box, {n, n}));
+}
+
 void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   validate_init(frame, box);
   frame_size_ = frame.size();
@@ -186,7 +199,8 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
 
   // Factorised convolution: each block's projection from the first window's cells (PCA).
   cv::Size cells;
-  const cv::Mat raw = raw_features(subwindow(frame, pos_, fw_.window, fw_.model), cells);
+  const cv::Mat window_patch = subwindow(frame, pos_, fw_.window, fw_.model);
+  const cv::Mat raw = raw_features(window_patch, cells);
   hog_projection_ = pca_projection(raw.rowRange(0, kHogBlock), p_.hog_dims);
   cn_projection_ = colour_ ? pca_projection(raw.rowRange(kHogBlock, raw.rows), p_.cn_dims) : cv::Mat();
 
@@ -198,7 +212,12 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
   scale_filter_.learn(frame, pos_, scale_, 1.0);
   colour_model_ = ColourHistogram(p_.hist_bins, p_.inner_padding);
-  if (p_.hist_weight > 0) colour_model_.learn(subwindow(frame, pos_, fw_.window, fw_.model), target_in_model(), 1.0);
+  if (p_.hist_weight > 0) colour_model_.learn(window_patch, target_in_model(), 1.0);
+  // The verifier's first exemplar: the box given.
+  verifier_ = AppearanceVerifier(p_.verify_exemplars);
+  similarity_ = 1;
+  unverified_frames_ = last_exemplar_ = 0;
+  if (p_.verify_threshold > 0) verifier_.add(verifier_patch(window_patch, {0, 0}, fw_.model.width / fw_.window.width));
   initialised_ = true;
 }
 
@@ -294,6 +313,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   unconfident_frames_ = confident ? 0 : unconfident_frames_ + 1;
 
   const cv::Point2d shift = peak_offset(d);
+  const double model_per_px = fw_.model.width / (fw_.window.width * scale_);  // of d's patch
   const double px_per_cell = p_.cell * fw_.window.width * scale_ / fw_.model.width;
   pos_.x = std::clamp(d.centre.x + shift.x * px_per_cell, 0.0, frame.cols - 1.0);
   pos_.y = std::clamp(d.centre.y + shift.y * px_per_cell, 0.0, frame.rows - 1.0);
@@ -316,6 +336,20 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   s.confidence = confidence;
   doubtful_frames_ = confidence < p_.lost_confidence ? doubtful_frames_ + 1 : 0;
   s.lost = doubtful_frames_ >= p_.lost_after;
+  if (p_.verify_threshold > 0) {
+    // The conservative verifier: does the box still look like the target? It learns only on
+    // very confident frames that also pass it, so a box sliding onto what the filter has come to
+    // match does not teach it (TLD's conservative model, Kalal et al. 2012).
+    const cv::Mat patch = verifier_patch(d.patch, pos_ - d.centre, model_per_px);
+    similarity_ = verifier_.similarity(patch);
+    unverified_frames_ = similarity_ < p_.verify_threshold ? unverified_frames_ + 1 : 0;
+    s.lost = s.lost || unverified_frames_ >= p_.verify_after;
+    if (confidence >= p_.verify_learn_confidence && similarity_ >= p_.verify_learn_similarity &&
+        frames_ - last_exemplar_ >= p_.verify_interval) {
+      verifier_.add(patch);
+      last_exemplar_ = frames_;
+    }
+  }
   s.redetected = redetected;
   LevelStats level;
   level.evaluated = static_cast<int>(d.response.total()) * windows + (confident ? p_.scales : 0);

@@ -19,7 +19,9 @@
 //  * colour: Staple's foreground/background histogram likelihood merged with the response (as dcf);
 //  * scale: DSST's scale filter;
 //  * loss and re-detection: the state says lost once the response's peak or APCE has stayed far
-//    below its running mean for a few frames; while lost, the 8 neighbouring windows are searched
+//    below its running mean for a few frames, or once the box has stopped looking like the
+//    target's conservative exemplars for a few frames (verifier.hpp: TLD's conservative model;
+//    the flag only, never the track); while lost, the 8 neighbouring windows are searched
 //    every frame and,
 //    every global_interval frames, the whole image at a coarse resolution (the filter as a
 //    spatial kernel over the image's feature map), the best candidates then verified at full
@@ -35,6 +37,7 @@
 #include "air/track/dcf/scale_filter.hpp"
 #include "air/track/dcf/window.hpp"
 #include "air/track/eco/sample_space.hpp"
+#include "air/track/eco/verifier.hpp"
 #include "air/track/tracker.hpp"
 
 namespace aerie::track {
@@ -79,6 +82,19 @@ struct EcoParams {
   double confidence_rate = 0.05;
   double lost_confidence = 0.15;  // chosen on simulated exits (bench/track/lost_rule.py)
   int lost_after = 3;
+  // Appearance verifier (verifier.hpp; TLD's conservative model, Kalal et al. 2012): the state
+  // also says lost once the similarity (largest normalised cross-correlation of the box's grey
+  // 16x16 patch with the exemplars) has stayed below verify_threshold for verify_after frames in
+  // a row; 0 switches it off. Exemplars: the first frame's box, then the box of a frame whose
+  // confidence reaches verify_learn_confidence and whose similarity reaches
+  // verify_learn_similarity, at most one every verify_interval frames, verify_exemplars at most
+  // (the first kept, the oldest of the others replaced). It changes the LOST flag only.
+  double verify_threshold = 0.4;  // chosen on simulated exits (bench/track/lost_rule.py)
+  int verify_after = 5;
+  int verify_exemplars = 8;
+  double verify_learn_confidence = 0.9;
+  double verify_learn_similarity = 0.7;
+  int verify_interval = 10;
   // Re-detection: after lost_frames unconfident frames in a row, the 8 windows around the current
   // one every frame, and every global_interval frames the whole image at a resolution of at most
   // global_pixels pixels; a candidate is taken when its confidence reaches found_confidence.
@@ -101,6 +117,8 @@ class EcoTracker : public Tracker {
   std::string name() const override { return name_; }
   void init(const cv::Mat& frame, const cv::Rect2d& box) override;
   TrackState update(const cv::Mat& frame) override;
+  // The verifier's similarity of the last box (1 before the first update and while it is switched off).
+  double similarity() const { return similarity_; }
 
  private:
   struct Detection {
@@ -124,6 +142,9 @@ class EcoTracker : public Tracker {
   void add_sample(const Detection& d, cv::Point2d shift_cells);
   cv::Size2d target_in_model() const { return target_ * (fw_.model.width / fw_.window.width); }
   void train();
+  // The verifier's patch of the box centred `offset` image pixels from the centre of a window
+  // patch (a detection's, already resized to the model: cheap whatever the target's size).
+  cv::Mat verifier_patch(const cv::Mat& window_patch, cv::Point2d offset, double model_per_px) const;
 
   EcoParams p_;
   std::string name_;
@@ -144,6 +165,10 @@ class EcoTracker : public Tracker {
 
   double mean_peak_ = 0, mean_apce_ = 0;
   int frames_ = 0, since_training_ = 0, unconfident_frames_ = 0, doubtful_frames_ = 0;
+
+  AppearanceVerifier verifier_;
+  double similarity_ = 1;
+  int unverified_frames_ = 0, last_exemplar_ = 0;
 };
 
 }  // namespace aerie::track

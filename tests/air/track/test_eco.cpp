@@ -1,8 +1,8 @@
 // The ECO tracker's parts against hand-computed or brute-force references (colour names,
 // the PCA projection, the Gaussian-mixture sample space, Newton's refinement of the continuous
-// response) and its own behaviour: determinism, the LOST flag while the target is out of the
-// image, the whole-image re-detection when it comes back. (The shared motion tests are in
-// test_trackers.cpp.)
+// response, the appearance verifier's correlation) and its own behaviour: determinism, the LOST
+// flag while the target is out of the image or the box sits on background, the whole-image
+// re-detection when it comes back. (The shared motion tests are in test_trackers.cpp.)
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -12,6 +12,7 @@
 #include "air/track/eco/newton.hpp"
 #include "air/track/eco/projection.hpp"
 #include "air/track/eco/sample_space.hpp"
+#include "air/track/eco/verifier.hpp"
 #include "tests/air/track/synthetic.hpp"
 
 using namespace aerie::track;
@@ -268,5 +269,152 @@ TEST(Eco, BadParametersAreNamed) {
   EXPECT_NE(message([](EcoParams& p) { p.aberrance = NAN; }).find("aberrance"), std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.learning_rate = 0; }).find("learning rates"), std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.global_pixels = 10; }).find("global_pixels"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_threshold = 1.5; }).find("verify_threshold"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_threshold = NAN; }).find("verify_threshold"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_after = 0; }).find("verify_after"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_exemplars = 0; }).find("verify_exemplars"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_learn_confidence = -0.1; }).find("verify_learn_confidence"),
+            std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_learn_similarity = 2; }).find("verify_learn_similarity"),
+            std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.verify_interval = 0; }).find("verify_interval"), std::string::npos);
   EXPECT_EQ(message([](EcoParams&) {}), "accepted");
+}
+
+namespace {
+// The normalised cross-correlation of two equal-size float images, by its definition.
+double ncc(const cv::Mat& a, const cv::Mat& b) {
+  const cv::Scalar ma = cv::mean(a), mb = cv::mean(b);
+  const cv::Mat da = a - ma[0], db = b - mb[0];
+  return da.dot(db) / std::sqrt(da.dot(da) * db.dot(db));
+}
+constexpr int kN = AppearanceVerifier::kPatch, kS = AppearanceVerifier::kSize, kM = AppearanceVerifier::kMargin;
+}  // namespace
+
+// The similarity is the largest NCC of an exemplar (the centre of the patch it was learned
+// from) with any kSize x kSize part of the patch, by brute force; an exemplar moved by up to
+// kMargin pixels still matches exactly; a flat patch matches nothing; the first exemplar stays.
+TEST(AppearanceVerifier, LargestCorrelationOverExemplarsAndPlacements) {
+  cv::RNG rng(5);
+  auto random_patch = [&] {
+    cv::Mat m(kN, kN, CV_32F);
+    rng.fill(m, cv::RNG::UNIFORM, 0, 1);
+    return m;
+  };
+  const cv::Mat a = random_patch(), b = random_patch(), probe = random_patch();
+  AppearanceVerifier v(2);
+  EXPECT_EQ(v.similarity(probe), 0.0);  // no exemplar yet
+  v.add(a);
+  v.add(b);
+  ASSERT_EQ(v.size(), 2u);
+  double expected = -1;
+  for (const cv::Mat& e : {a, b})
+    for (int dy = 0; dy <= 2 * kM; ++dy)
+      for (int dx = 0; dx <= 2 * kM; ++dx)
+        expected = std::max(expected, ncc(e(cv::Rect(kM, kM, kS, kS)), probe(cv::Rect(dx, dy, kS, kS))));
+  EXPECT_NEAR(v.similarity(probe), expected, 1e-5);
+  EXPECT_LT(v.similarity(probe), 0.5);  // unrelated noise
+
+  // a, moved by (-2, +1) inside the patch: its centre is still one of the placements.
+  cv::Mat moved = random_patch();
+  a(cv::Rect(2, 0, kN - 2, kN - 1)).copyTo(moved(cv::Rect(0, 1, kN - 2, kN - 1)));
+  EXPECT_NEAR(v.similarity(moved), 1.0, 1e-5);
+  cv::Mat brighter = a * 0.5 + 0.2;  // NCC ignores gain and offset
+  EXPECT_NEAR(v.similarity(brighter), 1.0, 1e-5);
+
+  EXPECT_EQ(v.similarity(cv::Mat(kN, kN, CV_32F, cv::Scalar(0.4))), 0.0);
+  v.add(cv::Mat(kN, kN, CV_8U, cv::Scalar(90)));  // flat: not kept
+  EXPECT_EQ(v.size(), 2u);
+
+  // Full: the oldest but the first is replaced.
+  const cv::Mat c = random_patch();
+  v.add(c);
+  EXPECT_NEAR(v.similarity(a), 1.0, 1e-5);
+  EXPECT_NEAR(v.similarity(c), 1.0, 1e-5);
+  EXPECT_LT(v.similarity(b), 0.9);
+  EXPECT_THROW(v.similarity(cv::Mat(kS, kS, CV_32F)), std::invalid_argument);
+  EXPECT_THROW(AppearanceVerifier(0), std::invalid_argument);
+}
+
+namespace {
+// A textured target on a differently textured background that moves at 2 px per frame; from
+// frame `gone` on, the target is no longer drawn (moved far outside the image): the box is left
+// on the background, where the filter, which has learned the background around the target too,
+// may still find a peak.
+struct GoneScene {
+  Scene scene{{320, 240}, {40, 34}, 21};
+  int gone = 20;
+  Motion at(int i) const {
+    Motion m;
+    m.centre = {100 + 2.0 * std::min(i, gone), 110 + std::min(i, gone) * 0.5};
+    if (i >= gone) m.centre = {2000, 2000};
+    return m;
+  }
+};
+}  // namespace
+
+// The verifier alone (the confidence rule switched off) says lost within verify_after frames
+// (+1 for the frame the box needs to leave the target's last position) of the box being left
+// on background, and never while the target is tracked.
+TEST(Eco, VerifierFlagsTheBoxLeftOnBackgroundAndNotTheTrackedTarget) {
+  const GoneScene g;
+  EcoParams p;
+  ASSERT_GT(p.verify_threshold, 0.0);  // on by default
+  p.lost_confidence = 0;               // the confidence rule never fires
+  EcoTracker t(p);
+  t.init(g.scene.render(g.at(0)), g.scene.box(g.at(0)));
+  int first_lost = -1, false_alarms = 0;
+  double lowest_tracked = 1;
+  for (int i = 1; i < g.gone + 20; ++i) {
+    const TrackState s = t.update(g.scene.render(g.at(i)));
+    if (i < g.gone) {
+      false_alarms += s.lost;
+      lowest_tracked = std::min(lowest_tracked, t.similarity());
+    } else if (s.lost && first_lost < 0) {
+      first_lost = i;
+    }
+  }
+  EXPECT_EQ(false_alarms, 0);
+  EXPECT_GT(lowest_tracked, p.verify_threshold);
+  ASSERT_GE(first_lost, g.gone);
+  EXPECT_LE(first_lost, g.gone + p.verify_after);
+}
+
+// A steady target, moving, rotating a little and changing brightness: the verifier never
+// says lost (nor does the confidence rule) over 80 frames.
+TEST(Eco, VerifierQuietOnASteadilyTrackedTarget) {
+  const Scene scene({320, 240}, {44, 36}, 31);
+  auto at = [](int i) {
+    Motion m;
+    m.centre = {120 + 60 * std::sin(i / 15.0), 120 + 30 * std::sin(i / 23.0)};
+    m.theta = 0.1 * std::sin(i / 11.0);
+    m.gain = 1 + 0.15 * std::sin(i / 17.0);
+    return m;
+  };
+  EcoTracker t(EcoParams{});
+  t.init(scene.render(at(0)), scene.box(at(0)));
+  int lost = 0;
+  for (int i = 1; i <= 80; ++i) lost += t.update(scene.render(at(i))).lost;
+  EXPECT_EQ(lost, 0);
+  EXPECT_GT(t.similarity(), EcoParams{}.verify_threshold);
+}
+
+// The verifier changes the LOST flag only: with it on and off the boxes and confidences are
+// the same to the bit, on a sequence with a loss and a re-detection.
+TEST(Eco, VerifierDoesNotChangeTheTrack) {
+  const ExitScene e;
+  auto run = [&](double threshold) {
+    EcoParams p;
+    p.verify_threshold = threshold;
+    EcoTracker t(p);
+    t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
+    std::vector<double> out;
+    for (int i = 1; i < 70; ++i) {
+      const TrackState s = t.update(e.scene.render(e.at(i)));
+      out.insert(out.end(), {s.pose.x, s.pose.y, s.pose.scale, s.confidence});
+    }
+    return out;
+  };
+  EXPECT_EQ(run(0), run(EcoParams{}.verify_threshold));
+  EXPECT_EQ(run(0), run(0.9));
 }
