@@ -114,7 +114,9 @@ for t in "${targets[@]}"; do
   rate=$(final_stat average_exec_per_sec "$log")
   [ -n "$rate" ] || rate=$(stat_after exec/s "$log")
   status=ok
-  if [ $rc -ne 0 ] || [ "$found" -gt 0 ]; then
+  if [ "$found" -eq 0 ] && grep -q 'libFuzzer: run interrupted' "$log"; then
+    status="interrupted (SIGINT), no crash"  # Ctrl-C or kill -INT: libFuzzer exits non-zero
+  elif [ $rc -ne 0 ] || [ "$found" -gt 0 ]; then
     why=$({ grep -m1 -E 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:|what\(\):' "$log" || true; } \
       | sed -E 's/^==[0-9]+==//; s/^ +//' | cut -c1-100)
     status="CRASH: ${why:-see the log} ($(ls -t "$artifacts" | grep -v '^slow-unit-' | head -1))"

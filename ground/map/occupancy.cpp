@@ -514,25 +514,60 @@ void check_tree(const octomap::OcTree& tree, std::istream& in, const char* what)
 }  // namespace
 
 namespace {
+// Where OctoMap's reader will start reading the body: its header read as it reads it (the first
+// line, then AbstractOcTree::readHeader's whitespace-separated tokens up to the token "data" and
+// the end of its line), so that the body checked below is the one OctoMap reads. A header read
+// any other way (line by line, "data" alone on a line) checked a later body than OctoMap's
+// reader then read: a "data 49" line made an 8 kB .bt grow a tree without end (issue 19,
+// fuzz/regressions/octomap/bt_data_token_not_line_oom.bt). OctoMap's pre-2013 binary format
+// (no text header) is refused. Throws std::invalid_argument.
+size_t octree_body_offset(const std::string& bytes, bool binary) {
+  std::istringstream s(bytes);
+  std::string line;
+  std::getline(s, line);
+  const std::string first = binary ? "# Octomap OcTree binary file" : "# Octomap OcTree file";
+  if (line.compare(0, first.size(), first) != 0)
+    throw std::invalid_argument("a file whose first line is not '" + first + "'" +
+                                (binary ? " (an old binary format? OctoMap's convert_octree updates it)" : ""));
+  auto skip_line = [&s] {
+    char c = 0;
+    do c = static_cast<char>(s.get());
+    while (s.good() && c != '\n');
+  };
+  std::string token, id;
+  bool data = false;
+  while (s.good() && !data) {
+    s >> token;
+    if (token == "data") {
+      data = true;
+      skip_line();
+    } else if (token.compare(0, 1, "#") == 0) {
+      skip_line();
+    } else if (token == "id") {
+      s >> id;
+    } else if (token == "res") {
+      double res = 0;
+      s >> res;
+    } else if (token == "size") {
+      unsigned size = 0;
+      s >> size;
+    } else {
+      skip_line();
+    }
+  }
+  if (!data) throw std::invalid_argument("an OctoMap tree without a 'data' line");
+  if (id == "1") id = "OcTree";  // OctoMap's deprecated id
+  if (id != "OcTree") throw std::invalid_argument("a tree of id '" + id + "', not an OcTree");
+  return s.good() ? static_cast<size_t>(s.tellg()) : bytes.size();
+}
+
 // OctoMap's readers recurse once per tree level without a depth limit and read on after their
 // stream has failed: a crafted tree overflows the stack or, truncated, grows without end (issue
 // 19, fuzz/regressions/octomap). So the body is walked here first, iteratively: at most 16
 // levels (OctoMap's tree depth), every byte present, at most kMaxMapNodes nodes.
 // Throws std::invalid_argument naming what is wrong.
 void check_octree_body(const std::string& bytes, bool binary) {
-  // The header: lines up to "data" (OctoMap's AbstractOcTree::readHeader); then the body.
-  size_t pos = 0;
-  std::string id;
-  for (int line = 0;; ++line) {
-    const size_t eol = bytes.find('\n', pos);
-    if (eol == std::string::npos || line > 100) throw std::invalid_argument("an OctoMap tree without a 'data' line");
-    const std::string l = bytes.substr(pos, eol - pos);
-    pos = eol + 1;
-    if (l.rfind("id ", 0) == 0) id = l.substr(3);
-    if (l == "data" || l == "data\r") break;
-  }
-  while (!id.empty() && (id.back() == '\r' || id.back() == ' ')) id.pop_back();
-  if (id != "OcTree") throw std::invalid_argument("a tree of id '" + id + "', not an OcTree");
+  size_t pos = octree_body_offset(bytes, binary);
   if (pos == bytes.size()) return;  // an empty tree
   // .bt: 2 bytes per node, 2 bits per child (01 free leaf, 10 occupied leaf, 11 inner node).
   // .ot: per node a float and a byte of child flags; every child is a node of its own.

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -108,3 +109,30 @@ TEST(MapNode, LoadRefusesAnOtWithAGarbageBody) {
   EXPECT_EQ(wait_exit(spawn({AERIE_MAP_EXE, "--lcm-url", "memq://", "--save", "", "--load", garbage}), 20.0), 1);
   EXPECT_NO_THROW(aerie::map::read_octree_file(good));
 }
+
+TEST(MapNode, LoadChecksTheBodyOctoMapReadsNotALaterOne) {
+  // OctoMap's header is tokens: "data 49" ends it, and the body starts on the next line. The
+  // check read lines and looked for "data" alone on one, so it checked the (empty) body after a
+  // later "data" line while OctoMap read the 0xFF bytes first: a tree growing without end (fuzz
+  // finding, fuzz/regressions/octomap/bt_data_token_not_line_oom.bt: 24 GB under ASan).
+  const std::string header = "# Octomap OcTree binary file\nid OcTree\nsize 49\nres 0.1\ndata 49\n";
+  const std::string text = header + std::string(64, '\xff') + "\ndata\n";
+  std::istringstream in(text);
+  try {
+    aerie::map::read_octree(in, true);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("deeper than 16"), std::string::npos) << e.what();
+  }
+  // The old binary format (no text header) and a wrong first line are refused by name.
+  std::istringstream old(std::string("\x03\0\0\0", 4) + std::string(12, '\0'));
+  EXPECT_THROW(aerie::map::read_octree(old, true), std::invalid_argument);
+  std::istringstream wrong("# Octomap OcTree file\nid OcTree\nres 0.1\ndata\n");
+  try {
+    aerie::map::read_octree(wrong, true);  // an .ot header read as .bt
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("# Octomap OcTree binary file"), std::string::npos) << e.what();
+  }
+}
+
