@@ -72,13 +72,13 @@ std::optional<Snapshot> read_snapshot(const std::string& path, std::string& why)
   const double scale = 1.0 + s.P.cwiseAbs().maxCoeff();
   ok = ok && s.P.allFinite() && (s.P.diagonal().array() >= 0.0).all() &&
        (s.P - s.P.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale;  // symmetric, as written
-  ok = ok && (in >> k_anchor >> anchor) && k_anchor == "T_world_vo";
+  // The rest of the T_world_vo line: "none", or qw qx qy qz x y z.
+  ok = ok && (in >> k_anchor) && k_anchor == "T_world_vo" && std::getline(in >> std::ws, anchor);
   if (ok && anchor != "none") {
-    std::istringstream first(anchor);
+    std::istringstream a(anchor);
     Eigen::Quaterniond q;
     Vec3 t;
-    ok = static_cast<bool>(first >> q.w()) && (in >> q.x() >> q.y() >> q.z() >> t.x() >> t.y() >> t.z()) &&
-         q.coeffs().allFinite() && std::abs(q.norm() - 1.0) < 1e-6 && t.allFinite();
+    ok = get_quaternion(a, q) && (a >> t.x() >> t.y() >> t.z()) && t.allFinite() && !(a >> rest);
     if (ok) s.T_world_vo = geometry::SE3(q, t);
   }
   if (!ok || (in >> rest)) {

@@ -161,6 +161,21 @@ def choose(scored):
     return max(scored, key=lambda r: (rates(scored[r])[0] - rates(scored[r])[1], -rates(scored[r])[1]))
 
 
+def table(header, rules, label, best, tune_runs, report_runs):
+    """One row per rule: its label, then recall and false alarms on both sets."""
+    print(header)
+    for r in rules:
+        (rt, ft), (rr, fr) = rates(score(tune_runs, r)), rates(score(report_runs, r))
+        print(f"{label(r)} | {rt:13.3f} {ft:13.4f} | {rr:13.3f} {fr:13.4f}{'  <- chosen' if r == best else ''}")
+
+
+def summary(title, scored, best, report_runs):
+    """The rule chosen on the tuning set (scored), its figures there and on the report set."""
+    print(f"{title}: {describe(best)}")
+    print(f"  tuned on : {fmt(scored[best])}")
+    print(f"  reported : {fmt(score(report_runs, best))}")
+
+
 def main(tracker, tune, report):
     (tune_runs, tune_traced), (report_runs, report_traced) = series(tune, tracker), series(report, tracker)
     traced = tune_traced and report_traced
@@ -170,30 +185,19 @@ def main(tracker, tune, report):
     # The confidence rule alone (the rule before the verifier).
     alone = {(t, k, OFF, OFF): score(tune_runs, (t, k, OFF, OFF)) for t, k in conf_rules}
     best_alone = choose(alone)
-    k = best_alone[1]
-    print("lost_confidence  lost_after | tuning recall  false alarms | report recall  false alarms")
-    for r in alone:
-        if r[1] in (1, k):
-            (rt, ft), (rr, fr) = rates(alone[r]), rates(score(report_runs, r))
-            print(f"{r[0]:15.2f} {r[1]:11d} | {rt:13.3f} {ft:13.4f} | {rr:13.3f} {fr:13.4f}{'  <- chosen' if r == best_alone else ''}")
-    print(f"confidence alone, chosen on {tune}: {describe(best_alone)}")
-    print(f"  tuned on : {fmt(alone[best_alone])}")
-    print(f"  reported : {fmt(score(report_runs, best_alone))}")
+    table("lost_confidence  lost_after | tuning recall  false alarms | report recall  false alarms",
+          [r for r in alone if r[1] in (1, best_alone[1])], lambda r: f"{r[0]:15.2f} {r[1]:11d}", best_alone,
+          tune_runs, report_runs)
+    summary(f"confidence alone, chosen on {tune}", alone, best_alone, report_runs)
     best = best_alone
     if traced:
         # The verifier alone, then beside the confidence rule, all chosen on the tuning set.
         only = {(OFF, OFF, vi, vk): score(tune_runs, (OFF, OFF, vi, vk)) for vi, vk in verify_rules}
         best_only = choose(only)
-        vk = best_only[3]
-        print("\nverify_threshold  verify_after | tuning recall  false alarms | report recall  false alarms  (verifier alone)")
-        for r in only:
-            if r[3] in (1, vk):
-                (rt, ft), (rr, fr) = rates(only[r]), rates(score(report_runs, r))
-                print(f"{VERIFY_THRESHOLDS[r[2]]:16.2f} {r[3]:13d} | {rt:13.3f} {ft:13.4f} | {rr:13.3f} {fr:13.4f}"
-                      f"{'  <- chosen' if r == best_only else ''}")
-        print(f"verifier alone, chosen on {tune}: {describe(best_only)}")
-        print(f"  tuned on : {fmt(only[best_only])}")
-        print(f"  reported : {fmt(score(report_runs, best_only))}")
+        table("\nverify_threshold  verify_after | tuning recall  false alarms | report recall  false alarms  (verifier alone)",
+              [r for r in only if r[3] in (1, best_only[3])], lambda r: f"{VERIFY_THRESHOLDS[r[2]]:16.2f} {r[3]:13d}",
+              best_only, tune_runs, report_runs)
+        summary(f"verifier alone, chosen on {tune}", only, best_only, report_runs)
         # The verifier beside the confidence rule chosen above (the rule ECO flies): its threshold
         # and run length chosen on the tuning set, "off" among the choices.
         t, k = best_alone[0], best_alone[1]
@@ -201,9 +205,7 @@ def main(tracker, tune, report):
         for vi, vk in verify_rules:
             beside[(t, k, vi, vk)] = score(tune_runs, (t, k, vi, vk))
         best = choose(beside)
-        print(f"\nconfidence rule OR verifier, the verifier chosen on {tune}: {describe(best)}")
-        print(f"  tuned on : {fmt(beside[best])}")
-        print(f"  reported : {fmt(score(report_runs, best))}")
+        summary(f"\nconfidence rule OR verifier, the verifier chosen on {tune}", beside, best, report_runs)
         # For information: both rules chosen together (not what is flown).
         joint = dict(alone)
         joint.update(only)
@@ -211,15 +213,13 @@ def main(tracker, tune, report):
             for vi, vk in verify_rules:
                 joint[(ct, ck, vi, vk)] = score(tune_runs, (ct, ck, vi, vk))
         best_joint = choose(joint)
-        print(f"both chosen together on {tune} among {len(joint)} rules (for information): {describe(best_joint)}")
-        print(f"  tuned on : {fmt(joint[best_joint])}")
-        print(f"  reported : {fmt(score(report_runs, best_joint))}")
+        summary(f"both chosen together on {tune} among {len(joint)} rules (for information)", joint, best_joint,
+                report_runs)
         print("  every verifier threshold beside the confidence rule, at the chosen verify_after, on both sets:")
-        print("  verify_threshold | tuning recall  false alarms | report recall  false alarms")
-        for vi in range(len(VERIFY_THRESHOLDS)):
-            r = (t, k, vi, best[3] if best[3] is not None else 1)
-            (rt, ft), (rr, fr) = rates(score(tune_runs, r)), rates(score(report_runs, r))
-            print(f"  {VERIFY_THRESHOLDS[vi]:16.2f} | {rt:13.3f} {ft:13.4f} | {rr:13.3f} {fr:13.4f}{'  <- chosen' if r == best else ''}")
+        vk = best[3] if best[3] is not None else 1
+        table("  verify_threshold | tuning recall  false alarms | report recall  false alarms",
+              [(t, k, vi, vk) for vi in range(len(VERIFY_THRESHOLDS))], lambda r: f"  {VERIFY_THRESHOLDS[r[2]]:16.2f}",
+              best, tune_runs, report_runs)
     print(f"  re-acquisition, tuning set : {reacquisition(tune_runs)}")
     print(f"  re-acquisition, report set : {reacquisition(report_runs)}")
     try:

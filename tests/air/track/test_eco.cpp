@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "air/track/eco/colour_names.hpp"
 #include "air/track/eco/eco.hpp"
@@ -190,6 +191,18 @@ struct ExitScene {
   }
 };
 
+// x, y, scale and confidence of every frame after the first, `frames` frames of the exit scene.
+std::vector<double> exit_track(const ExitScene& e, const EcoParams& p, int frames) {
+  EcoTracker t(p);
+  t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
+  std::vector<double> out;
+  for (int i = 1; i < frames; ++i) {
+    const TrackState s = t.update(e.scene.render(e.at(i)));
+    out.insert(out.end(), {s.pose.x, s.pose.y, s.pose.scale, s.confidence});
+  }
+  return out;
+}
+
 }  // namespace
 
 // On the frame it learned from, the response peaks at zero shift: the box stays.
@@ -248,17 +261,7 @@ TEST(Eco, WithoutTheWholeImageSearchTheFarTargetStaysLost) {
 
 TEST(Eco, SameInputSameTrack) {
   const ExitScene e;
-  auto run = [&] {
-    EcoTracker t(EcoParams{});
-    t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
-    std::vector<double> out;
-    for (int i = 1; i < 50; ++i) {
-      const TrackState s = t.update(e.scene.render(e.at(i)));
-      out.insert(out.end(), {s.pose.x, s.pose.y, s.pose.scale, s.confidence});
-    }
-    return out;
-  };
-  EXPECT_EQ(run(), run());
+  EXPECT_EQ(exit_track(e, EcoParams{}, 50), exit_track(e, EcoParams{}, 50));
 }
 
 TEST(Eco, BadParametersAreNamed) {
@@ -406,14 +409,7 @@ TEST(Eco, VerifierDoesNotChangeTheTrack) {
   auto run = [&](double threshold) {
     EcoParams p;
     p.verify_threshold = threshold;
-    EcoTracker t(p);
-    t.init(e.scene.render(e.at(0)), e.scene.box(e.at(0)));
-    std::vector<double> out;
-    for (int i = 1; i < 70; ++i) {
-      const TrackState s = t.update(e.scene.render(e.at(i)));
-      out.insert(out.end(), {s.pose.x, s.pose.y, s.pose.scale, s.confidence});
-    }
-    return out;
+    return exit_track(e, p, 70);
   };
   EXPECT_EQ(run(0), run(EcoParams{}.verify_threshold));
   EXPECT_EQ(run(0), run(0.9));
