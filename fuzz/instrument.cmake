@@ -8,7 +8,8 @@ if(AERIE_BUILD_FUZZ)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
     set(AERIE_FUZZ_LIBFUZZER ON)
     add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
-                        -fno-omit-frame-pointer)
+                        -fno-omit-frame-pointer
+                        -fsanitize-coverage-ignorelist=${CMAKE_CURRENT_LIST_DIR}/coverage_ignorelist.txt)
     add_link_options(-fsanitize=address,undefined)
   else()
     message(WARNING "AERIE_BUILD_FUZZ needs clang (libFuzzer); with ${CMAKE_CXX_COMPILER_ID} only the "

@@ -169,11 +169,13 @@ void SphericalDepth::validate() const {
   grid.validate();
   require(std::isfinite(range_scale_m) && range_scale_m > 0.f, "spherical depth: range_scale_m must be > 0");
   require(bins.size() == range_q.size(), "spherical depth: bins and ranges differ in count");
+  // The messages are built only for a bad bin: this loop runs over every bin of every VO_DEPTH.
   for (size_t i = 0; i < bins.size(); ++i) {
-    require(bins[i] >= 0 && bins[i] < grid.size(),
-            "spherical depth: bin " + std::to_string(bins[i]) + " outside the grid");
-    require(i == 0 || bins[i] > bins[i - 1], "spherical depth: bins not strictly ascending");
-    require(range_q[i] > 0, "spherical depth: range of bin " + std::to_string(bins[i]) + " is not positive");
+    if (bins[i] < 0 || bins[i] >= grid.size())
+      throw std::invalid_argument("spherical depth: bin " + std::to_string(bins[i]) + " outside the grid");
+    if (i > 0 && bins[i] <= bins[i - 1]) throw std::invalid_argument("spherical depth: bins not strictly ascending");
+    if (range_q[i] <= 0)
+      throw std::invalid_argument("spherical depth: range of bin " + std::to_string(bins[i]) + " is not positive");
   }
 }
 

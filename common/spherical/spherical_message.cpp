@@ -63,7 +63,7 @@ SphericalDepth from_message(const aerie::spherical_depth_t& m) {
                 std::to_string(m.nrange));
     for (int32_t b = 0; b < m.nrange; ++b) {
       const int16_t q = m.range[static_cast<size_t>(b)];
-      require(q >= 0, "negative range in bin " + std::to_string(b));
+      if (q < 0) require(false, "negative range in bin " + std::to_string(b));  // message built only then
       if (q == 0) continue;
       d.bins.push_back(b);
       d.range_q.push_back(q);
