@@ -70,7 +70,10 @@ void DistanceMap::update(OccupancyMap& map) {
 
 NearestObstacle DistanceMap::nearest(const Eigen::Vector3d& p) const {
   NearestObstacle out;
-  if (!impl_->edt || !p.allFinite()) return out;
+  // Outside the grid (the map's bounds grown by more than max_distance) no obstacle is within
+  // max_distance; there OctoMap's coordToKey would also overflow an int (docs/fuzz.md, finding 5).
+  if (!impl_->edt || !p.allFinite() || (p.array() < impl_->min.array()).any() || (p.array() > impl_->max.array()).any())
+    return out;
   float distance = 0.f;
   octomap::point3d obstacle;
   impl_->edt->getDistanceAndClosestObstacle(

@@ -289,6 +289,10 @@ TEST(DistanceMap, IncrementalUpdateSeesNewObstacles) {
   EXPECT_LT(distances.nearest({0.55, 0.05, 0.05}).distance, 0);  // 2.5 m > max_distance: none
   EXPECT_NEAR(distances.nearest({1.05, 0.05, 0.05}).distance, 2.0, 1e-6);
   EXPECT_NEAR(distances.nearest({2.55, 0.05, 0.05}).distance, 0.5, 1e-6);
+  // Far outside the grid: none, without OctoMap's key arithmetic (overflowed an int at 2e8 m).
+  EXPECT_LT(distances.nearest({-2.1e9, 0.05, 0.05}).distance, 0);
+  EXPECT_LT(distances.nearest({0.05, 0.05, 1e30}).distance, 0);
+  EXPECT_LT(distances.nearest({6.2, 0.05, 0.05}).distance, 0);  // just outside the grid (3.05 + 3 m)
   map.insert_frame({{1.55f, 0.05f, 0.05f}}, origin);
   distances.update(map);
   EXPECT_EQ(distances.rebuilds(), 1u);  // incremental
