@@ -29,4 +29,6 @@ int64_t trim_heap() {
   return std::max<int64_t>(0, before - rss_kb());
 }
 
+void map_large_blocks(size_t threshold_bytes) { mallopt(M_MMAP_THRESHOLD, static_cast<int>(threshold_bytes)); }
+
 }  // namespace aerie::util

@@ -6,6 +6,7 @@
 
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
+#include "common/util/heap.hpp"
 #include "ground/map/map_service.hpp"
 
 int main(int argc, char** argv) {
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("aerie-map", opts.log_level);
   aerie::bus::install_stop_handlers();  // early: a Ctrl-C while loading still saves at exit
+  aerie::util::map_large_blocks();      // util/heap.hpp
 
   try {
     const auto ext = std::filesystem::path(save_path).extension();

@@ -441,6 +441,9 @@ void MapService::on_cmd(const aerie::map_cmd_t& c, const bus::ReceiveInfo&) {
         // The octree's nodes are freed; hand their pages back (util/heap.hpp), or the RSS
         // keeps the largest map so far.
         status_.count("heap_released_kb", util::trim_heap());
+        // The heap with an empty map: the same state after every CLEAR, so its growth over
+        // many flights is a leak, not a larger map (docs/results/soak.md).
+        status_.set("heap_in_use_after_clear_kb", util::heap_figures().in_use_kb);
         spdlog::info("map cleared");
         break;
       case aerie::map_cmd_t::PUBLISH_FULL:

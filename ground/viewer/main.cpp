@@ -11,6 +11,7 @@
 
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
+#include "common/util/heap.hpp"
 #include "common/util/time.hpp"
 #include "ground/viewer/viewer.hpp"
 
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
   app.add_option("--disable", disable, "renderers to start disabled (by name, e.g. octomap chart-latency)");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("viewer", common.log_level);
+  aerie::util::map_large_blocks();  // util/heap.hpp
 
   const bool headless = opts.offscreen || !snapshot.empty() || !record_dir.empty();
   opts.offscreen = headless;

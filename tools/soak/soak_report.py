@@ -8,7 +8,9 @@ DIR/soak.md, DIR/summary.json, DIR/rss.png and DIR/cpu.png.
 Per process: RSS after the warm-up (the median over the window that starts when the warm-up
 ends) and at the end (the median over the run's last window); the window is 60 s (two
 flights or more), shorter in short runs; growth = end / after warm-up - 1 (target < 5 %);
-also the slope of a least-squares line through every sample after the warm-up. The warm-up
+also the slope of a least-squares line through every sample after the warm-up, and the growth
+of the per-flight floor (the least RSS of each flight: the last three flights' median against
+the first three's after the warm-up). The warm-up
 is --warmup-minutes (default 3) or a third of the run, whichever is shorter. Processes
 restarted every flight (aerie-pilot, aerie-flightsim) are compared by the peak RSS of each
 run: the median of the first three runs after the warm-up against that of the last three. CPU: percent of one core, mean
@@ -69,6 +71,27 @@ def fit(ts, ys):
         return math.nan, math.nan
     slope = sum((t - mt) * (y - my) for t, y in zip(ts, ys)) / sxx
     return slope, my - slope * mt
+
+
+def pct(v):
+    return "–" if v is None or math.isnan(v) else f"{v * 100:+.1f} %"
+
+
+def floor_growth(s, flights, warm, t_end):
+    """The growth of a whole-run process's floor: the least RSS of each flight that starts after the
+    warm-up, the median of the last three flights' against the first three's (fewer in short runs).
+    Flights leave aerie-map in the same state (empty after MAP_CMD CLEAR), so its floor compares
+    like with like where a window's median follows the size of the map being built."""
+    floors = []
+    for f in flights:
+        a, b = float(f["start_s"]), min(float(f["end_s"]), t_end)
+        v = [x[2] for x in s if a <= x[0] <= b]
+        if a >= warm and v:
+            floors.append(min(v))
+    if len(floors) < 2:
+        return math.nan
+    k = max(1, min(3, len(floors) // 3))
+    return median(floors[-k:]) / median(floors[:k]) - 1
 
 
 def fmt(v, spec=".1f", none="–"):
@@ -147,7 +170,8 @@ def main():
             b, e = median(base), median(end)
             slope, _ = fit([x[0] for x in after], [x[2] for x in after])
             row.update(mode="whole run", rss_base_mb=b / 1024.0, rss_end_mb=e / 1024.0,
-                       growth=e / b - 1 if b else math.nan, slope_mb_h=slope * 3600 / 1024.0 if not math.isnan(slope) else math.nan)
+                       growth=e / b - 1 if b else math.nan, slope_mb_h=slope * 3600 / 1024.0 if not math.isnan(slope) else math.nan,
+                       floor_growth=floor_growth(s, flights, warm, t_end))
         rows.append(row)
 
     # --- Status counters: errors, drops (summed over a node's processes) -----------------
@@ -206,7 +230,10 @@ def main():
                "producer_skipped": log["producer_skipped"] if log else None,
                "load1_mean": sum(loads) / len(loads) if loads else None, "load1_max": max(loads) if loads else None,
                "host_cpu_mean_percent": sum(host_cpu) / len(host_cpu) if host_cpu else None,
-               "rss_growth_below_target": ok_rss, "nodes": rows,
+               "rss_growth_below_target": ok_rss,
+               "rss_floor_growth_below_target": all(not (r.get("floor_growth", math.nan) >= TARGET_GROWTH) for r in rows
+                                                    if r["node"] not in ("xvfb", "soak-monitor")),
+               "nodes": rows,
                "status_counters": {n: dict(node_counters[n]) for n in status_nodes}}
 
     # --- Plots -----------------------------------------------------------------------------
@@ -246,23 +273,28 @@ def main():
              f"{summary['backlog_drops']} packets during the run" if backlog else "") + ".")
     worst = max((r for r in rows if r["node"] not in ("xvfb", "soak-monitor") and not math.isnan(r["growth"])),
                 key=lambda r: r["growth"], default=None)
+    floors = [r for r in rows if r["node"] not in ("xvfb", "soak-monitor") and not math.isnan(r.get("floor_growth", math.nan))]
+    worst_floor = max(floors, key=lambda r: r["floor_growth"], default=None)
     if worst:
-        L.append(f"* RSS after the warm-up ({warm / 60:.1f} min): largest growth {worst['growth'] * 100:+.1f} % "
-                 f"({worst['node']}); target < 5 %: **{'met' if ok_rss else 'not met'}**.")
+        L.append(f"* RSS after the warm-up ({warm / 60:.1f} min), target < 5 %: largest growth {worst['growth'] * 100:+.1f} % "
+                 f"({worst['node']}): **{'met' if ok_rss else 'not met'}**"
+                 + (f"; of the per-flight floors {worst_floor['floor_growth'] * 100:+.1f} % ({worst_floor['node']}): "
+                    f"**{'met' if summary['rss_floor_growth_below_target'] else 'not met'}**" if worst_floor else "") + ".")
     L.append("")
     L.append("## Processes\n")
     L.append("| process | program | runs | RSS after warm-up (MB) | RSS at the end (MB) | growth | slope after warm-up (MB/h) "
-             "| peak RSS (MB) | CPU mean / p95 (% of a core) | threads | UDP datagrams dropped |")
-    L.append("|---|---|---|---|---|---|---|---|---|---|---|")
+             "| growth of the per-flight floor | peak RSS (MB) | CPU mean / p95 (% of a core) | threads | UDP datagrams dropped |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         L.append(f"| {r['node']} | {r['program']} | {r['instances']} | {fmt(r['rss_base_mb'])} | {fmt(r['rss_end_mb'])} "
-                 f"| {fmt(r['growth'] * 100 if not math.isnan(r['growth']) else math.nan, '+.1f')} % "
-                 f"| {fmt(r['slope_mb_h'], '+.2f')} | {fmt(r['rss_peak_mb'])} | {fmt(r['cpu_mean'])} / {fmt(r['cpu_p95'])} "
+                 f"| {pct(r['growth'])} "
+                 f"| {fmt(r['slope_mb_h'], '+.2f')} | {pct(r.get('floor_growth', math.nan))} | {fmt(r['rss_peak_mb'])} | {fmt(r['cpu_mean'])} / {fmt(r['cpu_p95'])} "
                  f"| {r['threads_max']} | {fmt(r['udp_drops'], 'd')} |")
     L.append("")
     L.append(f"Growth, for the processes that run the whole soak (runs = 1): the median RSS of the {window:.0f} s after "
              f"the warm-up ({warm / 60:.1f} min) against the median of the last {window:.0f} s; the slope is a least-squares "
-             "line through every 1-s sample after the warm-up. Processes restarted each flight (runs > 1): the median "
+             "line through every 1-s sample after the warm-up; the per-flight floor: the least RSS of each flight after the "
+             "warm-up, the median of the last three flights' against the first three's. Processes restarted each flight (runs > 1): the median "
              "peak RSS of their first three runs after the warm-up against that of their last three. CPU: 1-s samples of /proc/PID/stat (utime + stime) "
              "after the warm-up, in % of one core. UDP datagrams dropped: by the kernel, for a full receive buffer of "
              "the process's sockets (/proc/net/udp; every LCM socket receives every channel of the multicast group).\n")
