@@ -71,6 +71,22 @@ inline const std::vector<std::string> kControlChannels = {"VO_POSE",    "NAV_STA
 inline const std::vector<std::string> kNavChannels = {"IMU", "VO_POSE"};
 inline const std::vector<std::string> kPilotChannels = {"TARGET_POSE", "TRACK", "IMU", "PILOT_CMD"};
 inline const std::vector<std::string> kMapChannels = {"VO_POSE", "VO_DEPTH", "MAP_QUERY", "MAP_CMD"};
+// aerie-track as in the demo (config/track_landing.yaml): the down camera, operator commands and
+// the simulator's box it initialises on.
+inline const std::vector<std::string> kTrackChannels = {"CAM_DOWN", "TRACK_CMD", "GT_TRACK"};
+inline const std::vector<std::string> kVoChannels = {"CAM_STEREO"};
+// aerie-flightsim receives commands; CTRL_CMD is also its lock-step answer channel.
+inline const std::vector<std::string> kFlightSimChannels = {"CTRL_CMD"};
+// aerie-link (config/link.yaml): the first kLinkAirChannels are published on the air network
+// (air_to_ground relays them, but IMU, which stays on board), the others on the ground network
+// (ground_to_air relays them). Not PMD_DISCOVER, which both directions relay: aerie-link drops
+// the copy it published itself (its echo filter), the in-process link (SimLink) has no such
+// filter and would bounce it between the buses.
+inline const std::vector<std::string> kLinkChannels = {
+    "CAM_DOWN", "CAM_LEFT",  "CAM_STEREO", "GT_TRACK",     "GT_POSE",    "TRACK",     "TARGET_POSE",
+    "VO_POSE",  "VO_DEPTH",  "CTRL_CMD",   "MAP_QUERY",    "STATUS_VO",  "PMD_INFO2", "IMU",
+    "TRACK_CMD", "FLC_PARAMS", "MAP_RESPONSE", "PMD_ORDERS2"};
+inline constexpr size_t kLinkAirChannels = 14;
 // procman: orders to a deputy, reports to a sheriff.
 inline const std::vector<std::string> kProcmanChannels = {"PMD_ORDERS2", "PMD_INFO2"};
 

@@ -7,9 +7,15 @@ set(AERIE_FUZZ_LIBFUZZER OFF)
 if(AERIE_BUILD_FUZZ)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
     set(AERIE_FUZZ_LIBFUZZER ON)
+    set(ignorelist ${CMAKE_CURRENT_LIST_DIR}/coverage_ignorelist.txt)
     add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
-                        -fno-omit-frame-pointer
-                        -fsanitize-coverage-ignorelist=${CMAKE_CURRENT_LIST_DIR}/coverage_ignorelist.txt)
+                        -fno-omit-frame-pointer -fsanitize-coverage-ignorelist=${ignorelist})
+    # Clang's dependency files do not name the list: its hash in every object's flags makes an
+    # edit reconfigure and compile them again.
+    set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${ignorelist})
+    file(SHA1 ${ignorelist} ignorelist_hash)
+    string(SUBSTRING ${ignorelist_hash} 0 12 ignorelist_hash)
+    add_compile_definitions(AERIE_FUZZ_IGNORELIST=${ignorelist_hash})
     add_link_options(-fsanitize=address,undefined)
   else()
     message(WARNING "AERIE_BUILD_FUZZ needs clang (libFuzzer); with ${CMAKE_CXX_COMPILER_ID} only the "

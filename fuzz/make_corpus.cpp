@@ -8,16 +8,21 @@
 // for a second). With --reliability (the shared reliability reproducers, a folder given on the command line), the crafted inputs of the
 // reliability issue: each payload as it is, and on its channel of every node target that
 // subscribes to it. Files are written only when missing or different.
+#include <aerie/control_cmd_t.hpp>
 #include <aerie/flc_params_t.hpp>
+#include <aerie/gt_box_t.hpp>
 #include <aerie/gt_pose_t.hpp>
 #include <aerie/imu_t.hpp>
 #include <aerie/map_cmd_t.hpp>
 #include <aerie/map_query_t.hpp>
+#include <aerie/map_response_t.hpp>
 #include <aerie/nav_state_t.hpp>
 #include <aerie/pilot_cmd_t.hpp>
 #include <aerie/pose_t.hpp>
+#include <aerie/process_status_t.hpp>
 #include <aerie/stereo_image_t.hpp>
 #include <aerie/target_pose_t.hpp>
+#include <aerie/track_cmd_t.hpp>
 #include <aerie/track_t.hpp>
 
 #include <algorithm>
@@ -28,6 +33,7 @@
 #include <iterator>
 #include <map>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -37,6 +43,8 @@
 #include "common/flc/flc_io.hpp"
 #include "common/image/image_message.hpp"
 #include "common/logio/event_log.hpp"
+#include "common/sim/flight/flight_sim.hpp"
+#include "common/sim/simulation.hpp"
 #include "fuzz/fuzz_support.hpp"
 #include "fuzz_catalogue.hpp"
 #include "ground/map/octomap_message.hpp"
@@ -358,7 +366,15 @@ struct NodeTarget {
 };
 const NodeTarget kNodes[] = {{"node_control", &fuzz::kControlChannels}, {"node_nav", &fuzz::kNavChannels},
                              {"node_pilot", &fuzz::kPilotChannels},     {"node_map", &fuzz::kMapChannels},
-                             {"procman_messages", &fuzz::kProcmanChannels}};
+                             {"procman_messages", &fuzz::kProcmanChannels},
+                             {"node_track", &fuzz::kTrackChannels},     {"node_vo", &fuzz::kVoChannels},
+                             {"node_flightsim", &fuzz::kFlightSimChannels}, {"node_link", &fuzz::kLinkChannels}};
+
+const NodeTarget& node_named(const std::string& name) {
+  for (const NodeTarget& n : kNodes)
+    if (name == n.name) return n;
+  throw std::logic_error("no node target " + name);
+}
 
 int channel_index(const NodeTarget& node, const std::string& channel) {
   const auto& ch = *node.channels;
@@ -372,6 +388,225 @@ Bytes records(const NodeTarget& node, const std::vector<Message>& messages) {
   for (const Message& m : messages)
     if (const int i = channel_index(node, m.channel); i >= 0) fuzz::append_record(out, static_cast<uint8_t>(i), m.payload);
   return out;
+}
+
+// --- the track, VO, flight simulator and link targets' own sequences -----------------------
+// Kept out of all_messages(): lcm_messages and the other node targets keep their seeds. Images
+// are small (the targets' costs grow with them): 64 x 48 for the down camera, 96 x 72 for the
+// stereo pairs (aerie-vo's feature margins and buckets, config/vo.yaml, need at least 80 x 64).
+
+constexpr int kSeedWidth = 64, kSeedHeight = 48;
+constexpr int kStereoWidth = 96, kStereoHeight = 72;
+
+// The down camera of aerie-flightsim (its rig at 64 x 48) looking at the room's helipad from
+// 1.1 m, drifting and descending (the pad about 30 px wide, large enough for aerie-track to fit
+// its corners): frames as aerie-flightsim publishes them (intrinsics in the metadata) and their
+// GT_TRACK boxes.
+struct DownFrames {
+  std::vector<Message> images, boxes;
+  std::vector<cv::Rect2d> box;
+};
+
+DownFrames down_frames(int n) {
+  const sim::World world = sim::World::room(sim::WorldConfig{});
+  sim::RigConfig rig = sim::FlightSimConfig::down_rig();
+  rig.width = kSeedWidth;
+  rig.height = kSeedHeight;
+  const sim::StereoRenderer renderer(world, rig);
+  const sim::Intrinsics K = renderer.intrinsics();
+  const Eigen::Matrix3d R_wc = (Eigen::Matrix3d() << 1, 0, 0, 0, -1, 0, 0, 0, -1).finished();  // optical axis down
+  DownFrames out;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d eye = world.helipad().center + Eigen::Vector3d(0.03 * k, 0.02 * k, 1.1 - 0.02 * k);
+    const sim::StereoFrame f = renderer.render_mono(geometry::SE3(Eigen::Quaterniond(R_wc), eye), kT0 + k * 50'000, k);
+    aerie::image_t m = image::to_message(f.left, f.utime, f.seq);
+    image::set_metadata(m, "camera", "down");
+    image::set_metadata(m, "fx", std::to_string(K.fx));
+    image::set_metadata(m, "fy", std::to_string(K.fy));
+    image::set_metadata(m, "cx", std::to_string(K.cx));
+    image::set_metadata(m, "cy", std::to_string(K.cy));
+    out.images.push_back({"CAM_DOWN", encode(m)});
+    aerie::gt_box_t g{};
+    g.utime = f.utime;
+    g.seq = f.seq;
+    g.target = "helipad";
+    g.camera = "CAM_DOWN";
+    g.visible = f.target_visible;
+    g.x = f.target_box.x;
+    g.y = f.target_box.y;
+    g.width = f.target_box.width;
+    g.height = f.target_box.height;
+    for (int i = 0; i < 4; ++i) {
+      g.corners[i][0] = f.target_corners[static_cast<size_t>(i)].x;
+      g.corners[i][1] = f.target_corners[static_cast<size_t>(i)].y;
+    }
+    out.boxes.push_back({"GT_TRACK", encode(g)});
+    out.box.push_back(f.target_box);
+  }
+  return out;
+}
+
+Message track_command(int8_t command, const std::string& tracker = "", const cv::Rect2d& box = {},
+                      const std::vector<std::pair<std::string, std::string>>& params = {}) {
+  aerie::track_cmd_t c{};
+  c.utime = kT0;
+  c.command = command;
+  c.tracker = tracker;
+  c.x = box.x;
+  c.y = box.y;
+  c.width = box.width;
+  c.height = box.height;
+  for (const auto& [name, value] : params) {
+    c.param_names.push_back(name);
+    c.param_values.push_back(value);
+  }
+  c.nparams = static_cast<int32_t>(params.size());
+  return {"TRACK_CMD", encode(c)};
+}
+
+// Rectified pairs of the room seen by the VO rig (the simulator's 376 x 240 rig at 96 x 72)
+// flying its survey loop.
+std::vector<Message> stereo_pairs(int n, image::Encoding encoding = image::Encoding::Raw) {
+  const sim::World world = sim::World::room(sim::WorldConfig{});
+  sim::RigConfig rig;
+  rig.width = kStereoWidth;
+  rig.height = kStereoHeight;
+  sim::StereoSimulation simulation(world, rig, sim::Trajectory::survey_loops(world, 1, 1.0), 20.0, kT0);
+  const sim::Intrinsics K = simulation.intrinsics();
+  std::vector<Message> out;
+  sim::StereoFrame f;
+  for (int k = 0; k < n && simulation.next(f); ++k) {
+    aerie::stereo_image_t s{};
+    s.utime = f.utime;
+    s.seq = f.seq;
+    s.left = image::to_message(f.left, f.utime, f.seq, encoding);
+    s.right = image::to_message(f.right, f.utime, f.seq, encoding);
+    s.fx = K.fx;
+    s.fy = K.fy;
+    s.cx = K.cx;
+    s.cy = K.cy;
+    s.baseline_m = K.baseline;
+    out.push_back({"CAM_STEREO", encode(s)});
+  }
+  return out;
+}
+
+// CTRL_CMD answering aerie-flightsim's frame k (utime k x 50 ms from 0, its start time).
+Message control_command(int k, int8_t mode, float vx = 0, float vy = 0, float vz = 0, float yaw_rate = 0) {
+  aerie::control_cmd_t c{};
+  c.utime = int64_t{k} * 50'000;
+  c.seq = k;
+  c.mode = mode;
+  c.controller_id = "initial";
+  c.velocity_body[0] = vx;
+  c.velocity_body[1] = vy;
+  c.velocity_body[2] = vz;
+  c.yaw_rate_deg_s = yaw_rate;
+  return {"CTRL_CMD", encode(c)};
+}
+
+void track_seeds() {
+  const NodeTarget& node = node_named("node_track");
+  const DownFrames d = down_frames(6);
+  using C = aerie::track_cmd_t;
+  // The demo: initialised on the simulator's box of the same frame (init_from_gt 0), then STOP.
+  std::vector<Message> gt;
+  for (size_t k = 0; k + 1 < d.images.size(); ++k) {
+    gt.push_back(d.boxes[k]);
+    gt.push_back(d.images[k]);
+  }
+  gt.push_back(track_command(C::STOP));
+  gt.push_back(d.images.back());
+  seed(node.name, "gt_init_track_stop.bin", records(node, gt));
+  // An operator: INIT on the pad's box (with an override), RESET, SET_TRACKER, STOP.
+  const std::vector<Message> op = {d.images[0],
+                                   track_command(C::INIT, "", d.box[0], {{"search_radius", "8"}}),
+                                   d.images[1],
+                                   d.images[2],
+                                   track_command(C::RESET),
+                                   d.images[3],
+                                   track_command(C::SET_TRACKER, "ct", {}, {{"features", "50"}}),
+                                   d.images[4],
+                                   track_command(C::STOP),
+                                   d.images[5]};
+  seed(node.name, "operator_init_reset_set_stop.bin", records(node, op));
+  seed(node.name, "CAM_DOWN_64x48.bin", records(node, {d.images[0]}));
+  seed(node.name, "GT_TRACK_pad.bin", records(node, {d.boxes[0]}));
+  seed(node.name, "TRACK_CMD_init.bin", records(node, {track_command(C::INIT, "dcf", d.box[0])}));
+  seed(node.name, "TRACK_CMD_stop.bin", records(node, {track_command(C::STOP)}));
+}
+
+void vo_seeds() {
+  const NodeTarget& node = node_named("node_vo");
+  seed(node.name, "pairs_96x72.bin", records(node, stereo_pairs(3)));
+  const std::vector<Message> jpeg = stereo_pairs(4, image::Encoding::Jpeg);
+  seed(node.name, "pairs_96x72_jpeg.bin", records(node, jpeg));
+  seed(node.name, "pair_96x72_png.bin", records(node, stereo_pairs(1, image::Encoding::Png)));
+  // A duplicate, then an older pair.
+  seed(node.name, "pairs_duplicate_older.bin", records(node, {jpeg[0], jpeg[1], jpeg[1], jpeg[0]}));
+}
+
+void flightsim_seeds() {
+  const NodeTarget& node = node_named("node_flightsim");
+  using C = aerie::control_cmd_t;
+  // Take off, fly forward turning, hover, land (touchdown about frame 85, then disarmed): one
+  // answer per frame (100 frames, 5 s, the target's kMaxFrames).
+  std::vector<Message> flight;
+  int k = 0;
+  for (; k < 25; ++k) flight.push_back(control_command(k, C::TAKEOFF));
+  for (; k < 35; ++k) flight.push_back(control_command(k, C::ACTIVE, 0.5f, 0.1f, 0, 15));
+  for (; k < 40; ++k) flight.push_back(control_command(k, C::HOVER));
+  for (; k < 45; ++k) flight.push_back(control_command(k, C::FALLBACK_HOVER));
+  for (; k < 100; ++k) flight.push_back(control_command(k, C::LAND));
+  seed(node.name, "takeoff_fly_hover_land.bin", records(node, flight));
+  for (int8_t mode : {C::HOVER, C::ACTIVE, C::FALLBACK_HOVER, C::TAKEOFF, C::LAND})
+    seed(node.name, "CTRL_CMD_mode_" + std::to_string(mode) + ".bin",
+         records(node, {control_command(0, mode, 0.2f, 0, 0.1f, 5)}));
+  // Refused: beyond the vehicle's limits, not finite; then an answer from the past (no answer).
+  seed(node.name, "CTRL_CMD_refused.bin",
+       records(node, {control_command(0, C::TAKEOFF), control_command(1, C::ACTIVE, 40, 0, 0, 0),
+                      control_command(2, C::ACTIVE, NAN, 0, 0, 0), control_command(0, C::HOVER)}));
+}
+
+void link_seeds() {
+  const NodeTarget& node = node_named("node_link");
+  const DownFrames d = down_frames(3);
+  aerie::process_status_t st{};
+  st.utime = kT0;
+  st.node = "VO";
+  st.host = "air";
+  st.pid = 4242;
+  st.message = "OK";
+  st.counter_names = {"frames", "keyframes"};
+  st.counter_values = {120, 12};
+  st.ncounters = 2;
+  st.timing_names = {"total"};
+  st.timing_ms = {9.5};
+  st.ntimings = 1;
+  aerie::map_response_t r{};
+  r.utime = kT0;
+  r.kind = aerie::map_query_t::RAY;
+  r.occupancy = aerie::map_response_t::OCCUPIED;
+  r.voxel_size = 0.1;
+  r.distance = 1.5;
+  r.hit[0] = 1.5;
+  using C = aerie::track_cmd_t;
+  const std::vector<Message> pairs = stereo_pairs(1, image::Encoding::Jpeg);
+  const std::vector<Message> mixed = {d.images[0],  d.boxes[0], pairs[0], {"STATUS_VO", encode(st)},
+                                      control_command(1, aerie::control_cmd_t::ACTIVE, 0.3f),
+                                      track_command(C::INIT, "", d.box[0]), d.images[1], d.boxes[1],
+                                      {"MAP_RESPONSE", encode(r)}, d.images[2], track_command(C::STOP)};
+  seed(node.name, "downlink_uplink.bin", records(node, mixed));
+  seed(node.name, "CAM_DOWN_64x48.bin", records(node, {d.images[0]}));
+  seed(node.name, "CAM_STEREO_96x72_jpeg.bin", records(node, pairs));
+  seed(node.name, "STATUS_VO.bin", records(node, {{"STATUS_VO", encode(st)}}));
+  seed(node.name, "MAP_RESPONSE.bin", records(node, {{"MAP_RESPONSE", encode(r)}}));
+  seed(node.name, "TRACK_CMD_init.bin", records(node, {track_command(C::INIT, "", d.box[0])}));
+  seed(node.name, "CTRL_CMD.bin", records(node, {control_command(1, aerie::control_cmd_t::ACTIVE, 0.3f)}));
+  // Frames in a row, each re-encoded and queued for the transmitter.
+  std::vector<Message> burst;
+  for (int i = 0; i < 4; ++i) burst.push_back(d.images[static_cast<size_t>(i % 3)]);
+  seed(node.name, "CAM_DOWN_burst.bin", records(node, burst));
 }
 
 void message_seeds() {
@@ -569,7 +804,10 @@ const Route kRoutes[] = {
     {"vo_pose_", "node_map", "VO_POSE"},           {"vo_depth_", "node_map", "VO_DEPTH"},
     {"map_query_", "node_map", "MAP_QUERY"},       {"map_cmd_", "node_map", "MAP_CMD"},
     {"track_npoints", "node_pilot", "TRACK"},      {"orders2_", "procman_messages", "PMD_ORDERS2"},
-    {"info2_", "procman_messages", "PMD_INFO2"},
+    {"info2_", "procman_messages", "PMD_INFO2"},   {"gt_track_", "node_track", "GT_TRACK"},
+    {"track_cmd_", "node_track", "TRACK_CMD"},     {"image_", "node_track", "CAM_DOWN"},
+    {"stereo_left_", "node_vo", "CAM_STEREO"},     {"image_", "node_link", "CAM_DOWN"},
+    {"stereo_left_", "node_link", "CAM_STEREO"},   {"track_cmd_", "node_link", "TRACK_CMD"},
 };
 
 void reliability_regressions(const fs::path& dir) {
@@ -627,6 +865,10 @@ int main(int argc, char** argv) {
   }
   const std::vector<Message> messages = all_messages();
   message_seeds();
+  track_seeds();
+  vo_seeds();
+  flightsim_seeds();
+  link_seeds();
   copy_configs();
   pmd_seeds();
   calibration_seeds();
