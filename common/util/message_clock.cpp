@@ -53,14 +53,14 @@ MessageClockConfig MessageClockConfig::from_config(const Config& section) {
 MessageClock::MessageClock(std::string source, MessageClockConfig config)
     : source_(std::move(source)), cfg_((config.validate(), config)) {}
 
-bool MessageClock::near(int64_t a, int64_t b) const {
+bool within(int64_t a, int64_t b, int64_t limit) {
   const uint64_t d = a >= b ? static_cast<uint64_t>(a) - static_cast<uint64_t>(b)
                             : static_cast<uint64_t>(b) - static_cast<uint64_t>(a);
-  return d <= static_cast<uint64_t>(cfg_.max_jump_us);
+  return d <= static_cast<uint64_t>(limit);
 }
 
 MessageClock::Result MessageClock::observe(int64_t utime, int64_t now_us) {
-  if (!synced_ || near(utime, newest_)) {
+  if (!synced_ || within(utime, newest_, cfg_.max_jump_us)) {
     // The first message sets the time base; a message near the newest continues it, and
     // ends any confirmation of another time base (that one was an outlier).
     newest_ = synced_ ? std::max(newest_, utime) : utime;
@@ -70,7 +70,7 @@ MessageClock::Result MessageClock::observe(int64_t utime, int64_t now_us) {
     return {};
   }
   // A jump: a new time base is confirmed by consistent messages there, one at a time.
-  if (candidate_count_ > 0 && near(utime, candidate_)) {
+  if (candidate_count_ > 0 && within(utime, candidate_, cfg_.max_jump_us)) {
     candidate_ = std::max(candidate_, utime);
     ++candidate_count_;
   } else {

@@ -22,6 +22,9 @@
 
 namespace aerie::util {
 
+// |a - b| <= limit (limit >= 0) for message times, without int64 overflow on hostile stamps.
+bool within(int64_t a, int64_t b, int64_t limit);
+
 // A node's own clock in microseconds: util::wall_utime live; a test or a lock-step driver
 // passes its own.
 using NodeClock = std::function<int64_t()>;
@@ -66,8 +69,6 @@ class MessageClock {
   const MessageClockConfig& config() const { return cfg_; }
 
  private:
-  bool near(int64_t a, int64_t b) const;  // |a - b| <= max_jump, without overflow
-
   std::string source_;
   MessageClockConfig cfg_;
   bool synced_ = false, stale_reported_ = false;

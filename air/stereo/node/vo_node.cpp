@@ -10,6 +10,7 @@
 #include "air/stereo/vo/vo_config.hpp"
 #include "common/image/image_message.hpp"
 #include "common/spherical/spherical_message.hpp"
+#include "common/util/message_clock.hpp"
 #include "common/util/time.hpp"
 
 namespace aerie::stereo {
@@ -44,21 +45,15 @@ VoNode::VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& c
 
 VoNode::~VoNode() = default;
 
-namespace {
-// |a - b| > limit, without overflowing int64 on hostile stamps (docs/fuzz.md, finding 6).
-bool apart(int64_t a, int64_t b, int64_t limit) {
-  int64_t d = 0;
-  return __builtin_sub_overflow(a, b, &d) || d > limit || d < -limit;
-}
-}  // namespace
-
 void VoNode::check(const aerie::stereo_image_t& m) const {
   const std::string what = cfg_.input + " seq " + std::to_string(m.seq) + ": ";
   if (m.left.width != m.right.width || m.left.height != m.right.height)
     throw std::invalid_argument(what + "left is " + std::to_string(m.left.width) + "x" + std::to_string(m.left.height) +
                                 " but right is " + std::to_string(m.right.width) + "x" +
                                 std::to_string(m.right.height));
-  if (apart(m.left.utime, m.right.utime, cfg_.max_pair_skew_us) || apart(m.utime, m.left.utime, cfg_.max_pair_skew_us))
+  // Overflow-free: a hostile stamp overflowed |a - b| here (docs/fuzz.md, finding 6).
+  if (!util::within(m.left.utime, m.right.utime, cfg_.max_pair_skew_us) ||
+      !util::within(m.utime, m.left.utime, cfg_.max_pair_skew_us))
     throw std::invalid_argument(what + "left/right/pair utimes " + std::to_string(m.left.utime) + " / " +
                                 std::to_string(m.right.utime) + " / " + std::to_string(m.utime) + " differ by more than " +
                                 std::to_string(cfg_.max_pair_skew_us) + " us");
