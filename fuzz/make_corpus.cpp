@@ -44,6 +44,7 @@
 #include "common/image/image_message.hpp"
 #include "common/logio/event_log.hpp"
 #include "common/sim/flight/flight_sim.hpp"
+#include "common/sim/flight/node/flightsim_node.hpp"
 #include "common/sim/simulation.hpp"
 #include "fuzz/fuzz_support.hpp"
 #include "fuzz_catalogue.hpp"
@@ -419,28 +420,8 @@ DownFrames down_frames(int n) {
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector3d eye = world.helipad().center + Eigen::Vector3d(0.03 * k, 0.02 * k, 1.1 - 0.02 * k);
     const sim::StereoFrame f = renderer.render_mono(geometry::SE3(Eigen::Quaterniond(R_wc), eye), kT0 + k * 50'000, k);
-    aerie::image_t m = image::to_message(f.left, f.utime, f.seq);
-    image::set_metadata(m, "camera", "down");
-    image::set_metadata(m, "fx", std::to_string(K.fx));
-    image::set_metadata(m, "fy", std::to_string(K.fy));
-    image::set_metadata(m, "cx", std::to_string(K.cx));
-    image::set_metadata(m, "cy", std::to_string(K.cy));
-    out.images.push_back({"CAM_DOWN", encode(m)});
-    aerie::gt_box_t g{};
-    g.utime = f.utime;
-    g.seq = f.seq;
-    g.target = "helipad";
-    g.camera = "CAM_DOWN";
-    g.visible = f.target_visible;
-    g.x = f.target_box.x;
-    g.y = f.target_box.y;
-    g.width = f.target_box.width;
-    g.height = f.target_box.height;
-    for (int i = 0; i < 4; ++i) {
-      g.corners[i][0] = f.target_corners[static_cast<size_t>(i)].x;
-      g.corners[i][1] = f.target_corners[static_cast<size_t>(i)].y;
-    }
-    out.boxes.push_back({"GT_TRACK", encode(g)});
+    out.images.push_back({"CAM_DOWN", encode(sim::image_message(f.left, f.utime, f.seq, "down", K))});
+    out.boxes.push_back({"GT_TRACK", encode(sim::gt_box_message(f, f.utime, f.seq, "CAM_DOWN"))});
     out.box.push_back(f.target_box);
   }
   return out;

@@ -17,19 +17,36 @@ namespace aerie::sim {
 
 namespace {
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+}  // namespace
 
 aerie::image_t image_message(const cv::Mat& img, int64_t utime, int64_t seq, const std::string& camera,
                              const Intrinsics& K) {
   auto m = image::to_message(img, utime, seq);
   image::set_metadata(m, "camera", camera);
-  // The intrinsics travel with the image (aerie-track reads them: no calibration to mismatch).
   image::set_metadata(m, "fx", std::to_string(K.fx));
   image::set_metadata(m, "fy", std::to_string(K.fy));
   image::set_metadata(m, "cx", std::to_string(K.cx));
   image::set_metadata(m, "cy", std::to_string(K.cy));
   return m;
 }
-}  // namespace
+
+aerie::gt_box_t gt_box_message(const StereoFrame& down, int64_t utime, int64_t seq, const std::string& camera) {
+  aerie::gt_box_t g{};
+  g.utime = utime;
+  g.seq = seq;
+  g.target = "helipad";
+  g.camera = camera;
+  g.visible = down.target_visible;
+  g.x = down.target_box.x;
+  g.y = down.target_box.y;
+  g.width = down.target_box.width;
+  g.height = down.target_box.height;
+  for (int i = 0; i < 4; ++i) {
+    g.corners[i][0] = down.target_corners[static_cast<size_t>(i)].x;
+    g.corners[i][1] = down.target_corners[static_cast<size_t>(i)].y;
+  }
+  return g;
+}
 
 FlightSimNode::FlightSimNode(bus::Bus& bus, FlightSim& sim, FlightSimNodeOptions options)
     : bus_(bus), sim_(sim), opt_(std::move(options)) {
@@ -80,23 +97,8 @@ const FlightFrame& FlightSimNode::publish_next() {
     T.to_wxyz(p.orientation);
     bus_.publish(opt_.gt_pose_channel, p);
   }
-  if (!opt_.gt_track_channel.empty()) {
-    aerie::gt_box_t g{};
-    g.utime = f.utime;
-    g.seq = f.seq;
-    g.target = "helipad";
-    g.camera = opt_.down_channel;
-    g.visible = f.down.target_visible;
-    g.x = f.down.target_box.x;
-    g.y = f.down.target_box.y;
-    g.width = f.down.target_box.width;
-    g.height = f.down.target_box.height;
-    for (int i = 0; i < 4; ++i) {
-      g.corners[i][0] = f.down.target_corners[static_cast<size_t>(i)].x;
-      g.corners[i][1] = f.down.target_corners[static_cast<size_t>(i)].y;
-    }
-    bus_.publish(opt_.gt_track_channel, g);
-  }
+  if (!opt_.gt_track_channel.empty())
+    bus_.publish(opt_.gt_track_channel, gt_box_message(f.down, f.utime, f.seq, opt_.down_channel));
   if (!opt_.state_channel.empty()) {
     const auto& v = f.vehicle;
     const auto& o = sim_.outcome();

@@ -13,6 +13,8 @@
 // fast the consumers run. Real-time mode publishes frame k at wall time t_k / speed and
 // applies commands as they come.
 #include <aerie/control_cmd_t.hpp>
+#include <aerie/gt_box_t.hpp>
+#include <aerie/image_t.hpp>
 
 #include <cstdint>
 #include <map>
@@ -36,6 +38,13 @@ struct FlightSimNodeOptions {
   std::string gt_track_channel = "GT_TRACK";  // the pad's box in CAM_DOWN
   std::string state_channel = "SIM_STATE";
 };
+
+// The messages aerie-flightsim publishes for its down camera (also what the fuzz seeds of
+// aerie-track are made of): the image with its camera's name and intrinsics in the metadata
+// (aerie-track reads them: no calibration to mismatch), and the pad's box in it.
+aerie::image_t image_message(const cv::Mat& img, int64_t utime, int64_t seq, const std::string& camera,
+                             const Intrinsics& K);
+aerie::gt_box_t gt_box_message(const StereoFrame& down, int64_t utime, int64_t seq, const std::string& camera);
 
 class FlightSimNode {
  public:
