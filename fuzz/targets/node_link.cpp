@@ -66,7 +66,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::quiet();
   link::SplitBus buses(split());
   Sent from_air, from_ground;
-  link::ChannelMatcher jpeg(split().down.jpeg_channels);
+  static link::ChannelMatcher jpeg(split().down.jpeg_channels);  // its regex compiled once
   buses.on(link::Side::kGround)
       .subscribe_raw(".*", [&](const uint8_t* d, size_t n, const bus::ReceiveInfo& info) {
         std::pair<std::string, std::vector<uint8_t>> m{info.channel, {d, d + n}};
