@@ -158,3 +158,20 @@ TEST(InputClock, ReportsJumpsResyncsAndOutagesInTheStatus) {
   EXPECT_EQ(status.counter("CAM_LEFT.stale"), 0);
   EXPECT_NE(status.message().find("CAM_LEFT re-synchronised"), std::string::npos) << status.message();
 }
+
+// |a - b| <= limit over the whole int64 range: the subtraction a hostile stamp overflowed
+// (docs/fuzz.md, finding 6).
+TEST(Within, ExactAtTheLimitAndOverflowFreeAtTheExtremes) {
+  constexpr int64_t lo = std::numeric_limits<int64_t>::min(), hi = std::numeric_limits<int64_t>::max();
+  EXPECT_TRUE(aerie::util::within(1000, 1020, 20));
+  EXPECT_TRUE(aerie::util::within(1020, 1000, 20));
+  EXPECT_FALSE(aerie::util::within(1000, 1021, 20));
+  EXPECT_FALSE(aerie::util::within(1021, 1000, 20));
+  EXPECT_FALSE(aerie::util::within(lo, 0, 20000));
+  EXPECT_FALSE(aerie::util::within(0, lo, 20000));
+  EXPECT_FALSE(aerie::util::within(lo, hi, 20000));
+  EXPECT_FALSE(aerie::util::within(hi, lo, hi));  // 2^64 - 1 apart: beyond any int64 limit
+  EXPECT_TRUE(aerie::util::within(lo, lo + 5, 5));
+  EXPECT_TRUE(aerie::util::within(hi, hi - 5, 5));
+  EXPECT_TRUE(aerie::util::within(-1, hi - 1, hi));
+}

@@ -7,6 +7,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <limits>
+#include <tuple>
+
 #include "air/stereo/node/vo_node.hpp"
 #include "common/image/image_message.hpp"
 #include "common/sim/simulation.hpp"
@@ -128,6 +131,40 @@ TEST(VoNode, PublishesPosesAndDepthAndRefusesBadPairs) {
   EXPECT_EQ(node.processed(), 8);
   EXPECT_EQ(node.last()->status, stereo::VoStatus::Reset);
   EXPECT_EQ(status.counter("time_resets"), 1);
+}
+
+// Hostile stamps (INT64_MIN, INT64_MAX) in a pair: refused as a skew, naming the stamps,
+// counted; no overflow (docs/fuzz.md, finding 6) and the odometry goes on.
+TEST(VoNode, HostileStampsAreRefusedAsASkew) {
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "VO");
+  stereo::VoNode node(bus, status, without_ba());
+  Survey survey;
+  const auto K = survey.simulation.intrinsics();
+  sim::StereoFrame f;
+  ASSERT_TRUE(survey.simulation.next(f));
+  node.on_stereo(to_message(f, K), 0);
+  ASSERT_EQ(node.processed(), 1);
+  constexpr int64_t lo = std::numeric_limits<int64_t>::min(), hi = std::numeric_limits<int64_t>::max();
+  ASSERT_TRUE(survey.simulation.next(f));
+  int refused = 0;
+  for (const auto& [pair, left, right] : {std::tuple{f.utime, lo, f.utime}, std::tuple{f.utime, f.utime, lo},
+                                          std::tuple{lo, f.utime, f.utime}, std::tuple{hi, lo, hi},
+                                          std::tuple{lo, lo, hi}}) {
+    auto m = to_message(f, K);
+    m.utime = pair;
+    m.left.utime = left;
+    m.right.utime = right;
+    node.on_stereo(m, 0);
+    EXPECT_EQ(node.refused(), ++refused);
+    EXPECT_NE(status.message().find("differ by more than"), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find(std::to_string(lo)), std::string::npos) << status.message();
+  }
+  EXPECT_EQ(status.counter("refused_pairs"), 5);
+  EXPECT_EQ(node.processed(), 1);
+  node.on_stereo(to_message(f, K), 0);
+  EXPECT_EQ(node.processed(), 2);
+  EXPECT_EQ(node.last()->status, stereo::VoStatus::Ok);
 }
 
 TEST(VoNode, OneCorruptPairDoesNotRestartTheOdometryAPersistentNewCameraDoes) {
