@@ -155,7 +155,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     nav_node.emplace(nav_bus, [&] { return std::make_unique<nav::NavNode>(nav_bus, nc); });
   faults::Respawnable<control::ControlNode> control_node(
       control_bus, [&] { return std::make_unique<control::ControlNode>(control_bus, control_status, config.controller, co, now); });
-  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }};
+  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }, {}};
   flight.add("control", control_node);
   if (vo_node) flight.add("vo", *vo_node);
   if (nav_node) flight.add("nav", *nav_node);

@@ -48,7 +48,7 @@ RunResult fly(const RunConfig& config) {
   const util::NodeClock now = [&simulator] { return simulator.utime_of(simulator.time()); };
   faults::Respawnable<pilot::PilotNode> pilot_node(
       pilot_bus, [&] { return std::make_unique<pilot::PilotNode>(pilot_bus, config.pilot, pilot::PilotNodeOptions{}, now); });
-  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }};
+  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }, {}};
   flight.add("track", track_node);
   flight.add("pilot", pilot_node);
   auto wait_tracker = [&] {
