@@ -9,7 +9,8 @@
 // each message. The node runs as with --replay (every_frame: the LCM thread hands every frame
 // to the worker), and the target waits for the worker after each message, so an input always
 // runs the same way.
-// One change for cost: camera.width x camera.height is 160 x 120 (track_landing.yaml sets no
+// Changes: target.fit_h_when_cut on, so that the H-only pose runs as well. For cost:
+// camera.width x camera.height is 160 x 120 (track_landing.yaml sets no
 // camera, so frames up to 4096 x 4096 are decoded, which a PNG of some tens of kB can declare,
 // and the pad search falls back to the whole frame). The seeds are 64 x 48; larger frames are
 // refused before decoding (decode_errors), the code path of a frame larger than the configured
@@ -31,6 +32,7 @@ const track::NodeOptions& options() {
     o.command_channel = ch[1];
     o.gt_channel = ch[2];
     o.every_frame = true;
+    o.fit_h_when_cut = true;  // the H-only pose of a pad cut by the border too (off in the config)
     camera::CameraModel c;
     c.width = 160;
     c.height = 120;

@@ -65,15 +65,22 @@ double correlation(const cv::Mat& a, const cv::Mat& b) {
   return score.at<float>(0, 0);
 }
 
-// Image-to-top-view correlation of the quad (corners clockwise in the image) with the H: its
-// bar along corners[0] -> corners[1] (> 0 returned as is) or along corners[1] -> corners[2].
-std::pair<double, bool> marking_score(const cv::Mat& gray, const Quad& q, const cv::Mat& templ) {
+// The quad (corners clockwise in the image) warped to a kTop x kTop top view, q[0] at its
+// top left and q[1] at its top right.
+cv::Mat top_view(const cv::Mat& gray, const Quad& q) {
   const float e = kTop - 0.5f;
   const std::array<cv::Point2f, 4> top{{{-0.5f, -0.5f}, {e, -0.5f}, {e, e}, {-0.5f, e}}};
   const cv::Mat H = cv::getPerspectiveTransform(top.data(), q.data());
   cv::Mat view;
   cv::warpPerspective(gray, view, H, {kTop, kTop}, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
   view.convertTo(view, CV_32F);
+  return view;
+}
+
+// Correlation of the square's top view with the H: its bar along corners[0] -> corners[1]
+// (> 0 returned as is) or along corners[1] -> corners[2].
+std::pair<double, bool> marking_score(const cv::Mat& gray, const Quad& q, const cv::Mat& templ) {
+  const cv::Mat view = top_view(gray, q);
   const double along_x = correlation(view, templ), along_y = correlation(view, templ.t());
   return {std::max(along_x, along_y), along_y > along_x};
 }
@@ -81,15 +88,17 @@ std::pair<double, bool> marking_score(const cv::Mat& gray, const Quad& q, const 
 struct Candidate {
   Quad quad;
   double score = 0;
+  cv::Point2f centre, along_x, along_y;  // the H's centre and unit vectors along its bar and legs
+  float width = 0, height = 0;           // its box along them (px)
 };
 
-// Candidate squares seeded from the H (the pad's most distinctive part: at 50-100 px the thin
+// The pad's H: an isolated bright blob (the pad's most distinctive part: at 50-100 px the thin
 // white border no longer separates the dark square from dark patches of the floor, but the H
 // stays an isolated bright blob inside the dark square). Bright blobs of the window at Otsu's
 // level and halfway to its brightest 2 % whose shape is H-like (filling about half of their
-// convex hull, aspect about 0.48 / 0.38) give the square scaled from their minimal box;
-// best first: large and central.
-std::vector<Candidate> find_squares(const cv::Mat& gray, const cv::Rect& win, const PadGeometry& pad, const PadOptions& opt) {
+// convex hull, aspect about 0.48 / 0.38); quad: the H's bounding rectangle from the blob's
+// minimal box, corners[0] -> corners[1] along the bar (pad x); best first: large and central.
+std::vector<Candidate> find_hs(const cv::Mat& gray, const cv::Rect& win, const PadOptions& opt) {
   cv::Mat roi, bright;
   cv::GaussianBlur(gray(win), roi, {3, 3}, 0);
   const double otsu = cv::threshold(roi, bright, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
@@ -99,7 +108,6 @@ std::vector<Candidate> find_squares(const cv::Mat& gray, const cv::Rect& win, co
   for (int n = 0; hi > 0 && (n += hist[hi]) < 0.02 * roi.total();) --hi;
   const cv::Point2f centre(win.x + win.width / 2.0f, win.y + win.height / 2.0f);
   const double min_h = opt.min_side_px * 2 * kHx;  // the H of the smallest pad
-  const float half = static_cast<float>(0.5 - pad.border);
   std::vector<Candidate> out;
   for (const double level : {otsu, (otsu + hi) / 2}) {
     cv::threshold(roi, bright, level, 255, cv::THRESH_BINARY);
@@ -118,19 +126,33 @@ std::vector<Candidate> find_squares(const cv::Mat& gray, const cv::Rect& win, co
       const float a = box.angle * static_cast<float>(M_PI / 180);
       cv::Point2f ux(std::cos(a), std::sin(a)), uy(-std::sin(a), std::cos(a));
       if (box.size.width > box.size.height) std::swap(ux, uy);
-      ux *= shorter / 2 * half / static_cast<float>(kHx);
-      uy *= longer / 2 * half / static_cast<float>(kHy);
       Candidate k;
       const cv::Point2f m = box.center + cv::Point2f(win.tl());
+      k.centre = m, k.along_x = ux, k.along_y = uy, k.width = shorter, k.height = longer;
+      ux *= shorter / 2;
+      uy *= longer / 2;
       k.quad = {m - ux - uy, m + ux - uy, m + ux + uy, m - ux + uy};
       k.score = std::sqrt(area) * (1 - cv::norm(m - centre) / std::hypot(win.width, win.height));
       const bool seen = std::any_of(out.begin(), out.end(), [&](const Candidate& o) {  // at the other level
-        return cv::norm((o.quad[0] + o.quad[2]) / 2 - m) < 0.2 * shorter;
+        return cv::norm(o.centre - m) < 0.2 * shorter;
       });
       if (!seen) out.push_back(k);
     }
   }
   std::sort(out.begin(), out.end(), [](const Candidate& x, const Candidate& y) { return x.score > y.score; });
+  return out;
+}
+
+// Candidate dark squares: each H's rectangle scaled to the square around it.
+std::vector<Candidate> find_squares(const cv::Mat& gray, const cv::Rect& win, const PadGeometry& pad, const PadOptions& opt) {
+  std::vector<Candidate> out = find_hs(gray, win, opt);
+  const float half = static_cast<float>(0.5 - pad.border);
+  for (Candidate& k : out) {
+    const cv::Point2f ux = k.along_x * (k.width / 2 * half / static_cast<float>(kHx));
+    const cv::Point2f uy = k.along_y * (k.height / 2 * half / static_cast<float>(kHy));
+    const cv::Point2f m = k.centre;
+    k.quad = {m - ux - uy, m + ux - uy, m + ux + uy, m - ux + uy};
+  }
   return out;
 }
 
@@ -195,8 +217,10 @@ double edge_offset(const cv::Mat& gray, cv::Point2d base, cv::Point2d d, cv::Poi
 // the derivative's peak); a line fitted to these points robustly (Huber) per side; the corners
 // are the intersections of adjacent lines. Edges are better located than corners: clutter
 // next to a corner or the thin white border do not pull them. False when a side has too
-// few edge points.
-bool refine_sides(const cv::Mat& gray, Quad& q, double reach_fraction, double border = -1) {
+// few edge points. bright_inside: the H's rectangle instead (bright-to-dark steps, sampled
+// along the whole side: its short sides are the legs' ends, the gap between them has no step).
+bool refine_sides(const cv::Mat& gray, Quad& q, double reach_fraction, double border = -1, bool bright_inside = false) {
+  const double polarity = bright_inside ? -1 : 1, span = bright_inside ? 0.94 : 0.7, start = bright_inside ? 0.03 : 0.15;
   std::array<cv::Vec4f, 4> lines;  // (dx, dy, x0, y0)
   for (int i = 0; i < 4; ++i) {
     const cv::Point2d a(q[i]), b(q[(i + 1) % 4]);
@@ -205,15 +229,16 @@ bool refine_sides(const cv::Mat& gray, Quad& q, double reach_fraction, double bo
     const double reach = std::max(2.0, reach_fraction * len);
     const int steps = static_cast<int>(2 * reach / 0.5);
     std::vector<cv::Point2f> edge;
+    int first_third = 0, last_third = 0;  // edge points near each end of the side
     std::vector<double> profile(steps + 1);
-    const int samples = std::min(100, static_cast<int>(0.7 * len));
+    const int samples = std::min(100, static_cast<int>(span * len));
     for (int k = 0; k < samples; ++k) {
-      const cv::Point2d p = a + d * len * (0.15 + 0.7 * (k + 0.5) / samples);
+      const cv::Point2d p = a + d * len * (start + span * (k + 0.5) / samples);
       bool inside = true;
       for (int j = 0; j <= steps && inside; ++j) {
         const cv::Point2d s = p + n * (-reach + 0.5 * j);
         inside = s.x >= 0 && s.y >= 0 && s.x <= gray.cols - 1 && s.y <= gray.rows - 1;
-        if (inside) profile[j] = sample(gray, s.x, s.y);
+        if (inside) profile[j] = polarity * sample(gray, s.x, s.y);
       }
       if (!inside) continue;
       int best = -1;
@@ -224,8 +249,12 @@ bool refine_sides(const cv::Mat& gray, Quad& q, double reach_fraction, double bo
       const double l = profile[best] - profile[best - 2], c = best_step, r = profile[best + 2] - profile[best];
       const double off = (l - r) / (2 * (l - 2 * c + r));  // parabola vertex, in half pixels
       edge.emplace_back(p + n * (-reach + 0.5 * (best + (std::isfinite(off) ? std::clamp(off, -1.0, 1.0) : 0))));
+      first_third += 3 * k < samples;
+      last_third += 3 * k >= 2 * samples;
     }
     if (edge.size() < 5) return false;
+    // The H's short sides are two leg ends: a line through one of them alone is not the side.
+    if (bright_inside && (first_third < 3 || last_third < 3)) return false;
     cv::fitLine(edge, lines[i], cv::DIST_HUBER, 0, 0.01, 0.01);
     if (border >= 0) {  // the edge's offset from the model of the profile
       cv::Point2d ld(lines[i][0], lines[i][1]);
@@ -255,8 +284,8 @@ void make_clockwise(Quad& q) {
   if (area2 < 0) std::reverse(q.begin(), q.end());
 }
 
-void check(const cv::Mat& gray, const camera::CameraModel& cam, const PadGeometry& pad) {
-  auto bad = [](const std::string& what) { throw std::invalid_argument("observe_pad: " + what); };
+void check(const char* who, const cv::Mat& gray, const camera::CameraModel& cam, const PadGeometry& pad) {
+  auto bad = [&](const std::string& what) { throw std::invalid_argument(who + (": " + what)); };
   if (gray.empty()) bad("empty frame");
   if (!(std::isfinite(cam.fx) && std::isfinite(cam.fy) && cam.fx > 0 && cam.fy > 0))
     bad("camera focal lengths must be finite and > 0");
@@ -268,87 +297,150 @@ void check(const cv::Mat& gray, const camera::CameraModel& cam, const PadGeometr
   if (!(pad.border >= 0 && pad.border < 0.25)) bad("pad border must be in [0, 0.25) of the size");
 }
 
-}  // namespace
+// Top view of the H's rectangle (kTop x kTop, column = +x over the bar, row = -y).
+cv::Mat h_template() {
+  cv::Mat t(kTop, kTop, CV_32F);
+  for (int r = 0; r < kTop; ++r)
+    for (int c = 0; c < kTop; ++c) {
+      double sum = 0;
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i)
+          sum += marking(((c + (i + 0.5) / 4) / kTop - 0.5) * 2 * kHx, -((r + (j + 0.5) / 4) / kTop - 0.5) * 2 * kHy, 0);
+      t.at<float>(r, c) = static_cast<float>(sum / 16);
+    }
+  return t;
+}
 
-std::optional<PadObservation> observe_pad(const cv::Mat& frame, const cv::Rect2d& search, const camera::CameraModel& camera,
-                                          const PadGeometry& pad, const PadOptions& opt, PadMiss* miss) {
-  check(frame, camera, pad);
-  PadMiss why = PadMiss::None;
-  auto reject = [&](PadMiss m) {
-    if (miss) *miss = std::max(m, why);
-    return std::nullopt;
-  };
-  const cv::Mat gray = to_gray(frame);
-  const cv::Rect win = cv::Rect(cv::Point(std::floor(search.x), std::floor(search.y)),
-                                cv::Point(std::ceil(search.x + search.width), std::ceil(search.y + search.height))) &
-                       cv::Rect(0, 0, gray.cols, gray.rows);
-  if (!std::isfinite(search.area()) || win.width < 2 * opt.min_side_px || win.height < 2 * opt.min_side_px)
-    return reject(PadMiss::EmptyWindow);
-
-  const std::vector<Candidate> candidates = find_squares(gray, win, pad, opt);
-  why = PadMiss::NoQuad;
-  const cv::Mat templ = marking_template(pad.border);
-  const double side_m = pad.size * (1 - 2 * pad.border);
-  const double h = side_m / 2;
-  const std::vector<cv::Point3d> object{{-h, h, 0}, {h, h, 0}, {h, -h, 0}, {-h, -h, 0}};
+// The quad's four corners in the image, clear of its border by the margin.
+bool in_image(const Quad& q, const cv::Mat& gray, const PadOptions& opt) {
   const cv::Rect2f inside(opt.border_margin_px, opt.border_margin_px, gray.cols - 1 - 2 * opt.border_margin_px,
                           gray.rows - 1 - 2 * opt.border_margin_px);
-  auto in_image = [&](const Quad& q) { return std::all_of(q.begin(), q.end(), [&](const cv::Point2f& p) { return inside.contains(p); }); };
+  return std::all_of(q.begin(), q.end(), [&](const cv::Point2f& p) { return inside.contains(p); });
+}
+
+// Pose of the planar rectangle with corners (-hx, hy), (hx, hy), (hx, -hy), (-hx, -hy) seen at
+// q (clockwise in the image, q[0] -> q[1] along +x): IPPE (Collins & Bartoli 2014) on the
+// undistorted corners (ideal pinhole pixels of the same K), polished by Levenberg-Marquardt.
+// The observation's corners and box are left to the caller.
+std::optional<PadObservation> rectangle_pose(const Quad& q, double hx, double hy, const camera::CameraModel& camera,
+                                             const PadOptions& opt) {
+  const std::vector<cv::Point3d> object{{-hx, hy, 0}, {hx, hy, 0}, {hx, -hy, 0}, {-hx, -hy, 0}};
+  std::vector<cv::Point2d> ideal(4);
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector3d ray = camera.unproject({q[i].x, q[i].y});
+    ideal[i] = {camera.fx * ray.x() + camera.cx, camera.fy * ray.y() + camera.cy};
+  }
+  cv::Vec3d rvec, tvec;
+  if (!cv::solvePnP(object, ideal, camera.K(), cv::noArray(), rvec, tvec, false,
+                    hx == hy ? cv::SOLVEPNP_IPPE_SQUARE : cv::SOLVEPNP_IPPE))
+    return std::nullopt;
+  cv::solvePnPRefineLM(object, ideal, camera.K(), cv::noArray(), rvec, tvec);  // IPPE is closed form: polish it
+  std::vector<cv::Point2d> reproj;
+  cv::projectPoints(object, rvec, tvec, camera.K(), cv::noArray(), reproj);
+  double sq = 0;
+  for (int i = 0; i < 4; ++i) sq += std::pow(cv::norm(reproj[i] - ideal[i]), 2);
+  const double rms = std::sqrt(sq / 4);
+  if (rms > opt.max_reprojection_px || tvec[2] <= 0) return std::nullopt;
+  PadObservation o;
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  for (int r = 0; r < 3; ++r) {
+    o.position[r] = tvec[r];
+    for (int c = 0; c < 3; ++c) o.rotation(r, c) = R(r, c);
+  }
+  o.yaw = std::remainder(std::atan2(R(1, 0), R(0, 0)), M_PI);  // modulo pi: the H's symmetry
+  if (o.yaw <= -M_PI / 2) o.yaw += M_PI;
+  o.reprojection_rms = rms;
+  return o;
+}
+
+// The axis-aligned box of four points, in their own precision (the fitted quad's is float).
+template <class Point>
+cv::Rect2d bounding_box(const std::array<Point, 4>& c) {
+  const auto [xmin, xmax] = std::minmax({c[0].x, c[1].x, c[2].x, c[3].x});
+  const auto [ymin, ymax] = std::minmax({c[0].y, c[1].y, c[2].y, c[3].y});
+  return cv::Rect2d(xmin, ymin, xmax - xmin, ymax - ymin);
+}
+
+cv::Rect window_in(const cv::Rect2d& search, const cv::Mat& gray) {
+  return cv::Rect(cv::Point(std::floor(search.x), std::floor(search.y)),
+                  cv::Point(std::ceil(search.x + search.width), std::ceil(search.y + search.height))) &
+         cv::Rect(0, 0, gray.cols, gray.rows);
+}
+
+// observe_pad (the dark square) or, h_only, observe_marking (the H's rectangle).
+std::optional<PadObservation> observe(bool h_only, const cv::Mat& frame, const cv::Rect2d& search,
+                                      const camera::CameraModel& camera, const PadGeometry& pad, const PadOptions& opt,
+                                      PadMiss* miss) {
+  check(h_only ? "observe_marking" : "observe_pad", frame, camera, pad);
+  const cv::Mat gray = to_gray(frame);
+  const cv::Rect win = window_in(search, gray);
+  if (!std::isfinite(search.area()) || win.width < 2 * opt.min_side_px || win.height < 2 * opt.min_side_px) {
+    if (miss) *miss = PadMiss::EmptyWindow;
+    return std::nullopt;
+  }
+  const std::vector<Candidate> candidates = h_only ? find_hs(gray, win, opt) : find_squares(gray, win, pad, opt);
+  static const cv::Mat h_templ = h_template();
+  const cv::Mat templ = h_only ? h_templ : marking_template(pad.border);
+  const double h = pad.size * (1 - 2 * pad.border) / 2;  // half side of the dark square
+  PadMiss why = PadMiss::NoQuad;
   for (size_t k = 0; k < std::min<size_t>(candidates.size(), 4); ++k) {
     Quad q = candidates[k].quad;
     make_clockwise(q);
-    // From the seed to the edges in two passes (the second one closer), whole pads only.
-    if (!in_image(q) || !refine_sides(gray, q, 0.06) || !in_image(q) || !refine_sides(gray, q, 0.025, pad.border) || !in_image(q)) {
-      why = std::max(why, in_image(q) ? PadMiss::NoQuad : PadMiss::TouchesBorder);
+    // From the seed to the edges in two passes (the second one closer), whole quads only.
+    const bool fitted = h_only ? in_image(q, gray, opt) && refine_sides(gray, q, 0.08, -1, true) && in_image(q, gray, opt) &&
+                                     refine_sides(gray, q, 0.03, -1, true)
+                               : in_image(q, gray, opt) && refine_sides(gray, q, 0.06) && in_image(q, gray, opt) &&
+                                     refine_sides(gray, q, 0.025, pad.border);
+    if (!fitted || !in_image(q, gray, opt)) {
+      why = std::max(why, in_image(q, gray, opt) ? PadMiss::NoQuad : PadMiss::TouchesBorder);
       continue;
     }
-    const auto [score, rotated] = marking_score(gray, q, templ);
+    // The square's 90 deg ambiguity is resolved by the H; the H's rectangle is not square:
+    // q[0] -> q[1] stays along its bar.
+    auto [score, rotated] = h_only ? std::pair{correlation(top_view(gray, q), templ), false} : marking_score(gray, q, templ);
     if (score < opt.min_marking_score) {
       why = std::max(why, PadMiss::NoMarking);
       continue;
     }
     if (rotated) std::rotate(q.begin(), q.begin() + 1, q.end());  // the bar along q[0] -> q[1]
-
-    // IPPE on the undistorted corners (ideal pinhole pixels of the same K).
-    std::vector<cv::Point2d> ideal(4);
-    for (int i = 0; i < 4; ++i) {
-      const Eigen::Vector3d ray = camera.unproject({q[i].x, q[i].y});
-      ideal[i] = {camera.fx * ray.x() + camera.cx, camera.fy * ray.y() + camera.cy};
-    }
-    cv::Vec3d rvec, tvec;
-    if (!cv::solvePnP(object, ideal, camera.K(), cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE_SQUARE)) {
+    std::optional<PadObservation> o =
+        h_only ? rectangle_pose(q, kHx * pad.size, kHy * pad.size, camera, opt) : rectangle_pose(q, h, h, camera, opt);
+    if (!o) {
       why = std::max(why, PadMiss::Reprojection);
       continue;
     }
-    cv::solvePnPRefineLM(object, ideal, camera.K(), cv::noArray(), rvec, tvec);  // IPPE is closed form: polish it
-    std::vector<cv::Point2d> reproj;
-    cv::projectPoints(object, rvec, tvec, camera.K(), cv::noArray(), reproj);
-    double sq = 0;
-    for (int i = 0; i < 4; ++i) sq += std::pow(cv::norm(reproj[i] - ideal[i]), 2);
-    const double rms = std::sqrt(sq / 4);
-    if (rms > opt.max_reprojection_px || tvec[2] <= 0) {
-      why = std::max(why, PadMiss::Reprojection);
-      continue;
+    if (h_only) {  // the dark square's corners where the pose puts them (partly outside the image)
+      const cv::Matx33d K = camera.K();
+      for (int i = 0; i < 4; ++i) {
+        const Eigen::Vector3d c = o->rotation * Eigen::Vector3d(i == 0 || i == 3 ? -h : h, i < 2 ? h : -h, 0) + o->position;
+        o->corners[i] = c.z() > 0 ? cv::Point2d(K(0, 0) * c.x() / c.z() + K(0, 2), K(1, 1) * c.y() / c.z() + K(1, 2))
+                                  : cv::Point2d(NAN, NAN);
+      }
+      o->box = bounding_box(o->corners);
+    } else {
+      for (int i = 0; i < 4; ++i) o->corners[i] = q[i];
+      o->box = bounding_box(q);
     }
-    PadObservation o;
-    cv::Matx33d R;
-    cv::Rodrigues(rvec, R);
-    for (int r = 0; r < 3; ++r) {
-      o.position[r] = tvec[r];
-      for (int c = 0; c < 3; ++c) o.rotation(r, c) = R(r, c);
-    }
-    o.yaw = std::remainder(std::atan2(R(1, 0), R(0, 0)), M_PI);  // modulo pi: the H's symmetry
-    if (o.yaw <= -M_PI / 2) o.yaw += M_PI;
-    for (int i = 0; i < 4; ++i) o.corners[i] = q[i];
-    o.reprojection_rms = rms;
-    o.marking_score = score;
-    const auto [xmin, xmax] = std::minmax({q[0].x, q[1].x, q[2].x, q[3].x});
-    const auto [ymin, ymax] = std::minmax({q[0].y, q[1].y, q[2].y, q[3].y});
-    o.box = cv::Rect2d(xmin, ymin, xmax - xmin, ymax - ymin);
+    o->marking_score = score;
+    o->marking_only = h_only;
     if (miss) *miss = PadMiss::None;
     return o;
   }
-  return reject(why);
+  if (miss) *miss = why;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<PadObservation> observe_pad(const cv::Mat& frame, const cv::Rect2d& search, const camera::CameraModel& camera,
+                                          const PadGeometry& pad, const PadOptions& opt, PadMiss* miss) {
+  return observe(false, frame, search, camera, pad, opt, miss);
+}
+
+std::optional<PadObservation> observe_marking(const cv::Mat& frame, const cv::Rect2d& search, const camera::CameraModel& camera,
+                                              const PadGeometry& pad, const PadOptions& opt, PadMiss* miss) {
+  return observe(true, frame, search, camera, pad, opt, miss);
 }
 
 }  // namespace aerie::track

@@ -46,6 +46,7 @@ struct PadObservation {
   double reprojection_rms = 0;  // px
   double marking_score = 0;     // correlation with the H template
   cv::Rect2d box;           // axis-aligned box of the corners
+  bool marking_only = false;  // the pose of the H alone (observe_marking); corners and box projected
 };
 
 // Why observe_pad found nothing (for the node's counters).
@@ -59,5 +60,16 @@ std::string to_string(PadMiss miss);
 // than the frame's) or a non-positive pad size.
 std::optional<PadObservation> observe_pad(const cv::Mat& gray, const cv::Rect2d& search, const camera::CameraModel& camera,
                                           const PadGeometry& pad, const PadOptions& options = {}, PadMiss* miss = nullptr);
+
+// The pad's pose from its H alone, for a pad too close to be seen whole (the dark square cut by
+// the image border, the H still inside): the four outer corners of the H's legs (the H's
+// bounding rectangle, size x 0.38 by size x 0.48) fitted as the square's sides are, with the
+// same IPPE + LM pose (the rectangle's 180 deg symmetry is the H's). Coarser than the square
+// far away (a side 0.4 x as long), as good at the heights where only the H fits. The result
+// has marking_only set; its corners and box are the dark square's projected by the pose.
+// Same arguments, misses and errors as observe_pad.
+std::optional<PadObservation> observe_marking(const cv::Mat& gray, const cv::Rect2d& search, const camera::CameraModel& camera,
+                                              const PadGeometry& pad, const PadOptions& options = {},
+                                              PadMiss* miss = nullptr);
 
 }  // namespace aerie::track

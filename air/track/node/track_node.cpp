@@ -17,8 +17,8 @@ NodeOptions node_options(const util::Config& cfg) {
   cfg.check_keys({"node.camera_channel", "node.stereo", "node.command_channel", "node.track_channel",
                   "node.pose_channel", "node.gt_channel", "node.tracker", "node.seed", "node.max_points",
                   "node.init_from_gt", "target.name", "target.width_m", "target.height_m", "target.yaw_offset_deg",
-                  "target.shape", "target.border", "target.search_margin", "target.reseed_iou", "camera.calibration",
-                  "camera.fx", "camera.fy", "camera.cx", "camera.cy", "camera.width", "camera.height", "trackers.*",
+                  "target.shape", "target.border", "target.search_margin", "target.reseed_iou", "target.fit_h_when_cut",
+                  "camera.calibration", "camera.fx", "camera.fy", "camera.cx", "camera.cy", "camera.width", "camera.height", "trackers.*",
                   "message_time.*"});
   NodeOptions o;
   const util::Config node = cfg.section("node");
@@ -48,6 +48,7 @@ NodeOptions node_options(const util::Config& cfg) {
   o.pad_border = target.get("border", o.pad_border);
   o.search_margin = target.get_in("search_margin", o.search_margin, 0.0, 10.0);
   o.reseed_iou = target.get_in("reseed_iou", o.reseed_iou, 0.0, 1.0);
+  o.fit_h_when_cut = target.get("fit_h_when_cut", o.fit_h_when_cut);
   if (!(o.pad_border >= 0 && o.pad_border < 0.25)) throw std::runtime_error(cfg.origin() + ": target.border must be in [0, 0.25)");
 
   const util::Config cam = cfg.section("camera");
@@ -454,10 +455,16 @@ std::optional<PadObservation> TrackNode::refine(const TrackState& s) {
   windows.emplace_back(0, 0, last_frame_.cols, last_frame_.rows);
   PadMiss miss = PadMiss::None;
   std::optional<PadObservation> pad;
+  const PadGeometry geometry{opt_.target.width_m, opt_.pad_border};
   try {
     for (size_t i = 0; i < windows.size() && !pad; ++i) {
-      pad = observe_pad(last_frame_, windows[i], *last_camera_, {opt_.target.width_m, opt_.pad_border}, {}, &miss);
+      pad = observe_pad(last_frame_, windows[i], *last_camera_, geometry, {}, &miss);
       if (pad && i > 0) count("pad_found_outside_track");
+    }
+    // Too close to be seen whole (low in the descent): the pose of its H, in the whole image.
+    if (!pad && opt_.fit_h_when_cut && miss != PadMiss::EmptyWindow) {
+      pad = observe_marking(last_frame_, windows.back(), *last_camera_, geometry, {}, &miss);
+      if (pad) count("pad_marking_only");
     }
   } catch (const std::exception& e) {  // e.g. a configured camera of another size than the frames
     count("pad_errors");
@@ -470,12 +477,13 @@ std::optional<PadObservation> TrackNode::refine(const TrackState& s) {
     return pad;
   }
   count("pad_refined");
+  last_pad_yaw_ = pad->yaw;
+  if (pad->marking_only) return pad;  // its box reaches out of the image: no box to seed a tracker with
   if (opt_.reseed_iou > 0 && iou(pad->box, box) < opt_.reseed_iou) {
     start_tracker(tracker_name_, tracker_params_, pad->box);  // same tracker and parameters, new box
     count("tracker_reseeded");
   }
   last_pad_box_ = pad->box;
-  last_pad_yaw_ = pad->yaw;
   return pad;
 }
 

@@ -62,6 +62,7 @@ struct NodeOptions {
   double pad_border = PadGeometry{}.border;  // square: white border of the pad, fraction of its side
   double search_margin = 0.5;  // square: the pad is searched in the box grown by this x its size per side
   double reseed_iou = 0.5;     // square: re-initialise the tracker on the pad when their IoU is below (0 = never)
+  bool fit_h_when_cut = false; // square: a pad cut by the image border gets the pose of its H alone (observe_marking)
   std::optional<camera::CameraModel> camera;  // intrinsics (stereo messages bring their own)
   // message_time.*: the camera's time (docs/architecture.md "Message time"): a frame whose utime
   // jumps is held (never tracked, so a bogus time never reaches TRACK / TARGET_POSE), a restart or

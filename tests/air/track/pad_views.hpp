@@ -12,7 +12,14 @@ struct PadView {
   sim::StereoFrame frame;              // frame.left is the image; target_* the pad's ground truth
   camera::CameraModel camera;          // the left camera
   Eigen::Vector3d position;            // true pad centre in the camera optical frame (m)
+  Eigen::Matrix3d rotation;            // true pad axes in the camera optical frame
   double yaw = 0;                      // true yaw of the pad's +x about the optical axis, (-pi/2, pi/2]
+
+  // Pixel of a point on the pad (metres along the pad's x and y from its centre).
+  cv::Point2d pixel(double x, double y) const {
+    const Eigen::Vector3d c = rotation * Eigen::Vector3d(x, y, 0) + position;
+    return {camera.fx * c.x() / c.z() + camera.cx, camera.fy * c.y() / c.z() + camera.cy};
+  }
 };
 
 inline double wrap_half_turn(double a) {
@@ -43,7 +50,8 @@ inline PadView pad_view(const sim::StereoRenderer& renderer, double height, doub
   v.frame = renderer.render(T_world_left, seq * 50'000, seq, blur);
   v.camera = renderer.intrinsics().calibration().left;
   v.position = T_world_left.inverse() * pad.center;
-  const Eigen::Vector3d x_cam = R_wc.transpose() * Eigen::Vector3d(std::cos(pad.yaw), std::sin(pad.yaw), 0);
+  v.rotation = R_wc.transpose() * Eigen::AngleAxisd(pad.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d x_cam = v.rotation.col(0);
   v.yaw = wrap_half_turn(std::atan2(x_cam.y(), x_cam.x()));
   return v;
 }

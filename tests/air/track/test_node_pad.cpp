@@ -36,9 +36,10 @@ class PadNodeTest : public ::testing::Test {
     o.target_shape = TargetShape::Square;
     return o;
   }
-  // Frame k of a slow descent from 2 m, turning; intrinsics in the metadata unless `fx` is given.
+  // Frame k of a slow descent from top_ (2 m) by step_ (2 cm) a frame, turning; intrinsics in
+  // the metadata unless `fx` is given.
   aerie::image_t frame(int k, PadView& v, const std::string& fx = "") {
-    v = pad_view(renderer_, 2.0 - 0.02 * k, 20 + 0.5 * k, 3, -2, {0.05, -0.02}, k);
+    v = pad_view(renderer_, top_ - step_ * k, 20 + 0.5 * k, 3, -2, {0.05, -0.02}, k);
     aerie::image_t m = aerie::image::to_message(v.frame.left, 1'000'000 + 50'000 * k, k);
     auto put = [&](const char* key, double value) { aerie::image::set_metadata(m, key, std::to_string(value)); };
     if (fx.empty()) put("fx", v.camera.fx);
@@ -82,6 +83,7 @@ class PadNodeTest : public ::testing::Test {
 
   aerie::bus::Bus bus_;
   aerie::sim::StereoRenderer renderer_;
+  double top_ = 2.0, step_ = 0.02;
   std::vector<aerie::target_pose_t> poses_;
 };
 
@@ -113,6 +115,25 @@ TEST_F(PadNodeTest, TrackerWrongInScaleIsReseededOnThePad) {
   EXPECT_LT((Eigen::Vector3d(p.position[0], p.position[1], p.position[2]) - last.position).norm(), 0.02);
 }
 
+// Low in the descent the pad is cut by the image border: the poses come from its H, still
+// fitted (SOURCE_FIT), and the tracker is not re-seeded on a box that leaves the image.
+TEST_F(PadNodeTest, TooCloseToSeeThePadWholeThePoseComesFromTheH) {
+  top_ = 1.1, step_ = 0.02;  // 1.1 m .. 0.64 m at 0.4 m/s
+  NodeOptions o = options();
+  o.tracker = "amcmr-ct";  // the landing's tracker (DCF loses the pad as it outgrows the image)
+  o.fit_h_when_cut = true;
+  TrackNode node(bus_, o);
+  const PadView last = run(node, 24);
+  ASSERT_EQ(poses_.size(), 23u);
+  for (const auto& p : poses_) EXPECT_EQ(p.source, aerie::target_pose_t::SOURCE_FIT) << p.utime;
+  const auto& p = poses_.back();
+  EXPECT_LT((Eigen::Vector3d(p.position[0], p.position[1], p.position[2]) - last.position).norm(), 0.02);
+  EXPECT_LT(std::abs(test::wrap_half_turn(p.yaw - last.yaw)), 2 * M_PI / 180);
+  EXPECT_EQ(node.counter("pad_refined"), 23);
+  EXPECT_GE(node.counter("pad_marking_only"), 12);
+  EXPECT_EQ(node.counter("tracker_reseeded"), 0);
+}
+
 TEST_F(PadNodeTest, BadMetadataIsCountedAndTheConfiguredCameraKept) {
   NodeOptions o = options();
   o.camera = renderer_.intrinsics().calibration().left;
@@ -131,10 +152,13 @@ TEST(PadNodeOptions, ShapeKeysAreParsedAndChecked) {
   EXPECT_DOUBLE_EQ(o.search_margin, 0.8);
   EXPECT_DOUBLE_EQ(o.reseed_iou, 0.3);
   EXPECT_DOUBLE_EQ(o.pad_border, 0.02);
+  EXPECT_FALSE(o.fit_h_when_cut);
+  EXPECT_TRUE(parse("target: {width_m: 1.0, shape: square, fit_h_when_cut: true}").fit_h_when_cut);
   EXPECT_EQ(parse("target: {width_m: 1.0}").target_shape, TargetShape::Box);
   EXPECT_THROW(parse("target: {shape: circle}"), std::runtime_error);
   EXPECT_THROW(parse("target: {reseed_iou: 1.5}"), std::runtime_error);
   EXPECT_THROW(parse("target: {search_margin: -1}"), std::runtime_error);
+  EXPECT_THROW(parse("target: {fit_h_when_cut: maybe}"), std::runtime_error);
   aerie::bus::Bus bus("memq://");
   NodeOptions no_size;
   no_size.target_shape = TargetShape::Square;

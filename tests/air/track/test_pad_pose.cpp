@@ -25,6 +25,16 @@ aerie::sim::StereoRenderer renderer(double noise_sigma = 2.0) {
 
 double yaw_error_deg(double a, double b) { return std::abs(wrap_half_turn(a - b)) * 180 / M_PI; }
 
+// The H's bounding rectangle (0.38 x 0.48 of the pad's side) is in the image, `margin` px clear.
+bool h_inside(const PadView& v, double size, double margin) {
+  for (const double x : {-0.19, 0.19})
+    for (const double y : {-0.24, 0.24}) {
+      const cv::Point2d p = v.pixel(x * size, y * size);
+      if (p.x < margin || p.y < margin || p.x > v.camera.width - 1 - margin || p.y > v.camera.height - 1 - margin) return false;
+    }
+  return true;
+}
+
 // The pad is seen whole, `margin` pixels clear of the image border.
 bool inside(const PadView& v, double margin) {
   const auto& b = v.frame.target_box;
@@ -128,6 +138,52 @@ TEST(PadPose, PartlyVisiblePadIsRejected) {
     EXPECT_FALSE(observe_pad(v.frame.left, grown(box, 0.3), v.camera, pad, {}, &miss));
     EXPECT_EQ(miss, PadMiss::TouchesBorder) << to_string(miss);
   }
+}
+
+// The H alone, low over the pad (0.4 .. 1.2 m: the dark square cut by the image border in most
+// views), turned, tilted and off-centre as above; the search window is the whole image.
+TEST(PadPose, MarkingOnlyLowOverThePad) {
+  const auto r = renderer();
+  const double tilts[][2] = {{0, 0}, {8, 0}, {0, -8}, {5, 5}, {-5, 4}};
+  const PadGeometry pad{world().helipad().size};
+  Errors err;
+  int k = 0, cut = 0, h_cut = 0;
+  for (double height : {0.4, 0.6, 0.8, 1.0, 1.2})
+    for (int heading = 0; heading < 180; heading += 15, ++k) {
+      const auto& tilt = tilts[k % 5];
+      const PadView v = pad_view(r, height, heading, tilt[0], tilt[1], {0.03 * (k % 3 - 1), -0.02 * (k % 2)}, k);
+      if (!h_inside(v, pad.size, 16)) {  // low and turned: the H itself does not fit in 240 rows
+        ++h_cut;
+        continue;
+      }
+      if (!inside(v, 3)) ++cut;
+      PadMiss miss = PadMiss::None;
+      const auto o = observe_marking(v.frame.left, {0, 0, 376, 240}, v.camera, pad, {}, &miss);
+      ASSERT_TRUE(o) << "height " << height << " heading " << heading << ": " << to_string(miss);
+      EXPECT_TRUE(o->marking_only);
+      EXPECT_LT((o->position - v.position).norm(), 0.015) << "height " << height << " heading " << heading;
+      EXPECT_LT(yaw_error_deg(o->yaw, v.yaw), 2.0) << "height " << height << " heading " << heading;
+      EXPECT_LT(o->reprojection_rms, 1.0);
+      err.add(v, *o);
+    }
+  std::printf("%d views (%d with the pad cut, %d skipped: the H cut): max position error %.4f m, max yaw error %.3f deg\n",
+              err.n, cut, h_cut, err.position, err.yaw);
+  EXPECT_GE(err.n, 45);
+  EXPECT_GE(cut, 25);
+}
+
+// Where the H itself is cut, or absent, observe_marking finds nothing (it never guesses).
+TEST(PadPose, MarkingOnlyNeedsTheWholeH) {
+  const auto r = renderer();
+  const PadGeometry pad{world().helipad().size};
+  PadMiss miss = PadMiss::None;
+  const PadView cut = pad_view(r, 0.6, 0, 0, 0, {0.3, 0.0});  // the H's centre 0.3 m off the axis, along the body
+  ASSERT_FALSE(h_inside(cut, pad.size, 0));
+  EXPECT_FALSE(observe_marking(cut.frame.left, {0, 0, 376, 240}, cut.camera, pad, {}, &miss));
+  EXPECT_NE(miss, PadMiss::None);
+  const PadView away = pad_view(r, 1.0, 20, 0, 0, {2.5, 0.0});
+  EXPECT_FALSE(observe_marking(away.frame.left, {0, 0, 376, 240}, away.camera, pad, {}, &miss));
+  EXPECT_NE(miss, PadMiss::None);
 }
 
 TEST(PadPose, RejectsBadArgumentsNamingTheProblem) {
