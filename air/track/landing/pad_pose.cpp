@@ -411,11 +411,10 @@ std::optional<PadObservation> observe(bool h_only, const cv::Mat& frame, const c
       continue;
     }
     if (h_only) {  // the dark square's corners where the pose puts them (partly outside the image)
-      const cv::Matx33d K = camera.K();
       for (int i = 0; i < 4; ++i) {
         const Eigen::Vector3d c = o->rotation * Eigen::Vector3d(i == 0 || i == 3 ? -h : h, i < 2 ? h : -h, 0) + o->position;
-        o->corners[i] = c.z() > 0 ? cv::Point2d(K(0, 0) * c.x() / c.z() + K(0, 2), K(1, 1) * c.y() / c.z() + K(1, 2))
-                                  : cv::Point2d(NAN, NAN);
+        const Eigen::Vector2d uv = c.z() > 0 ? camera.project(c) : Eigen::Vector2d::Constant(NAN);
+        o->corners[i] = {uv.x(), uv.y()};
       }
       o->box = bounding_box(o->corners);
     } else {

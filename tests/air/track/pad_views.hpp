@@ -17,8 +17,8 @@ struct PadView {
 
   // Pixel of a point on the pad (metres along the pad's x and y from its centre).
   cv::Point2d pixel(double x, double y) const {
-    const Eigen::Vector3d c = rotation * Eigen::Vector3d(x, y, 0) + position;
-    return {camera.fx * c.x() / c.z() + camera.cx, camera.fy * c.y() / c.z() + camera.cy};
+    const Eigen::Vector2d uv = camera.project(rotation * Eigen::Vector3d(x, y, 0) + position);
+    return {uv.x(), uv.y()};
   }
 };
 
