@@ -59,6 +59,15 @@ cv::Mat marking_template(double border) {
   return t;
 }
 
+// The square's template for this border, made once per thread and border (observe_pad runs on
+// every tracked frame, the border does not change; trackers run on several threads).
+const cv::Mat& square_template(double border) {
+  thread_local double made_for = NAN;
+  thread_local cv::Mat templ;
+  if (!(border == made_for)) templ = marking_template(border), made_for = border;
+  return templ;
+}
+
 double correlation(const cv::Mat& a, const cv::Mat& b) {
   cv::Mat score;
   cv::matchTemplate(a, b, score, cv::TM_CCOEFF_NORMED);
@@ -381,7 +390,7 @@ std::optional<PadObservation> observe(bool h_only, const cv::Mat& frame, const c
   }
   const std::vector<Candidate> candidates = h_only ? find_hs(gray, win, opt) : find_squares(gray, win, pad, opt);
   static const cv::Mat h_templ = h_template();
-  const cv::Mat templ = h_only ? h_templ : marking_template(pad.border);
+  const cv::Mat& templ = h_only ? h_templ : square_template(pad.border);
   const double h = pad.size * (1 - 2 * pad.border) / 2;  // half side of the dark square
   PadMiss why = PadMiss::NoQuad;
   for (size_t k = 0; k < std::min<size_t>(candidates.size(), 4); ++k) {
