@@ -112,21 +112,7 @@ FrameMessages MessageBuilder::build(const Frame& f, int64_t utime, int64_t seq) 
   }
   if (f.gt_box && !ch.gt_track.empty()) {
     const auto& b = *f.gt_box;
-    aerie::gt_box_t g;
-    g.utime = utime;
-    g.seq = seq;
-    g.target = b.target;
-    g.camera = image_channel;
-    g.visible = b.visible;
-    g.x = b.box.x;
-    g.y = b.box.y;
-    g.width = b.box.width;
-    g.height = b.box.height;
-    for (int i = 0; i < 4; ++i) {
-      g.corners[i][0] = b.corners[static_cast<size_t>(i)].x;
-      g.corners[i][1] = b.corners[static_cast<size_t>(i)].y;
-    }
-    m.gt_box = std::move(g);
+    m.gt_box = image::gt_box_message(utime, seq, b.target, image_channel, b.visible, b.box, b.corners);
   }
   return m;
 }

@@ -179,4 +179,23 @@ int64_t sequence_number(const aerie::image_t& msg) {
   return (ec == std::errc() && p == s->data() + s->size()) ? v : -1;
 }
 
+aerie::gt_box_t gt_box_message(int64_t utime, int64_t seq, const std::string& target, const std::string& camera,
+                               bool visible, const cv::Rect2d& box, const std::array<cv::Point2d, 4>& corners) {
+  aerie::gt_box_t g{};
+  g.utime = utime;
+  g.seq = seq;
+  g.target = target;
+  g.camera = camera;
+  g.visible = visible;
+  g.x = box.x;
+  g.y = box.y;
+  g.width = box.width;
+  g.height = box.height;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    g.corners[i][0] = corners[i].x;
+    g.corners[i][1] = corners[i].y;
+  }
+  return g;
+}
+
 }  // namespace aerie::image

@@ -1,7 +1,9 @@
 #pragma once
 // cv::Mat <-> aerie::image_t (bot_core.image_t layout): raw GRAY/RGB/BGR, JPEG, PNG.
+#include <aerie/gt_box_t.hpp>
 #include <aerie/image_t.hpp>
 
+#include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -39,5 +41,10 @@ void set_metadata(aerie::image_t& msg, const std::string& key, const std::string
 std::optional<std::string> metadata(const aerie::image_t& msg, const std::string& key);
 // metadata["seq"], or -1 when absent or not a number.
 int64_t sequence_number(const aerie::image_t& msg);
+
+// A target's true box in the image of `camera` (GT_TRACK): axis-aligned box (top-left
+// corner and size) and projected corners, pixels.
+aerie::gt_box_t gt_box_message(int64_t utime, int64_t seq, const std::string& target, const std::string& camera,
+                               bool visible, const cv::Rect2d& box, const std::array<cv::Point2d, 4>& corners);
 
 }  // namespace aerie::image

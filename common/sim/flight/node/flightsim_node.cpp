@@ -31,21 +31,7 @@ aerie::image_t image_message(const cv::Mat& img, int64_t utime, int64_t seq, con
 }
 
 aerie::gt_box_t gt_box_message(const StereoFrame& down, int64_t utime, int64_t seq, const std::string& camera) {
-  aerie::gt_box_t g{};
-  g.utime = utime;
-  g.seq = seq;
-  g.target = "helipad";
-  g.camera = camera;
-  g.visible = down.target_visible;
-  g.x = down.target_box.x;
-  g.y = down.target_box.y;
-  g.width = down.target_box.width;
-  g.height = down.target_box.height;
-  for (int i = 0; i < 4; ++i) {
-    g.corners[i][0] = down.target_corners[static_cast<size_t>(i)].x;
-    g.corners[i][1] = down.target_corners[static_cast<size_t>(i)].y;
-  }
-  return g;
+  return image::gt_box_message(utime, seq, "helipad", camera, down.target_visible, down.target_box, down.target_corners);
 }
 
 FlightSimNode::FlightSimNode(bus::Bus& bus, FlightSim& sim, FlightSimNodeOptions options)
