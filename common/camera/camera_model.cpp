@@ -31,6 +31,11 @@ cv::Mat CameraModel::D() const {
 void CameraModel::validate(const std::string& what) const {
   auto bad = [&](const std::string& msg) { throw std::invalid_argument(what + ": " + msg); };
   if (width <= 0 || height <= 0) bad("resolution must be positive, got " + std::to_string(width) + "x" + std::to_string(height));
+  // The rectifier's maps and the renderers allocate per pixel: bound the size by what a camera
+  // has (a 61 MP full-frame sensor is 9504 x 6336), not by what an int holds.
+  if (width > kMaxSide || height > kMaxSide || int64_t{width} * height > kMaxPixels)
+    bad("resolution " + std::to_string(width) + "x" + std::to_string(height) + " exceeds " +
+        std::to_string(kMaxSide) + " pixels a side or " + std::to_string(kMaxPixels) + " pixels");
   for (double v : {fx, fy, cx, cy}) {
     if (!std::isfinite(v)) bad("intrinsics are not finite");
   }

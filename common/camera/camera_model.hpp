@@ -2,6 +2,7 @@
 // Pinhole camera with optional lens distortion, and a calibrated stereo rig.
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct CameraModel {
   cv::Matx33d K() const { return {fx, 0, cx, 0, fy, cy, 0, 0, 1}; }
   cv::Mat D() const;  // distortion coefficients as OpenCV wants them
 
+  // Largest image a camera model may have (validate refuses more).
+  static constexpr int kMaxSide = 16384;
+  static constexpr int64_t kMaxPixels = int64_t{1} << 26;  // 67 MP
   // Throws std::invalid_argument naming `what` and the bad field.
   void validate(const std::string& what) const;
 

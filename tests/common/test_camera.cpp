@@ -163,6 +163,35 @@ TEST(Calibration, MalformedOpenCvYamlIsRefusedNotHung) {
   }
 }
 
+TEST(Calibration, ImageSizesNoCameraHasAreRefused) {
+  // The reader bounds its ints, but the rectifier allocates maps per pixel: 65535 x 65535 would
+  // ask for tens of GB on a calibration file alone.
+  StereoCalibration c;
+  c.left = {640, 480, 500, 500, 320, 240, Distortion::None, {}};
+  c.right = c.left;
+  c.T_right_left = aerie::geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.1, 0, 0));
+  c.source = "test";
+  const auto dir = aerie::test::scratch_dir("huge");
+  for (const auto& [w, h] : {std::pair{16385, 100}, std::pair{100, 65535}, std::pair{9000, 8000}}) {
+    c.left.width = c.right.width = w;
+    c.left.height = c.right.height = h;
+    c.left.cx = c.right.cx = w / 2.0;
+    c.left.cy = c.right.cy = h / 2.0;
+    write_opencv_stereo(c, dir / "stereo.yaml");
+    try {
+      read_stereo_calibration((dir / "stereo.yaml").string());
+      FAIL() << w << "x" << h << " accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("resolution " + std::to_string(w) + "x" + std::to_string(h) + " exceeds"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  c.left.width = c.right.width = 8192;  // 8192 x 8192 = 2^26 pixels: the largest accepted
+  c.left.height = c.right.height = 8192;
+  EXPECT_NO_THROW(c.validate());
+}
+
 TEST(Calibration, OpenCvYamlWithoutDistortionRoundTrips) {
   StereoCalibration c;
   c.left = {376, 240, 300, 300, 188, 120, Distortion::None, {}};
