@@ -124,6 +124,7 @@ bool MapService::accept_time(int64_t utime) {
     // A new time base (VO restarted, or came back after an outage): poses and waiting depth of
     // the old one would match the wrong frames. The map itself is kept.
     poses_.clear();
+    pose_arrivals_.clear();
     pending_.clear();
     newest_utime_ = utime;
     last_depth_utime_ = -1;
@@ -156,8 +157,13 @@ void MapService::on_pose(const aerie::pose_t& msg, const bus::ReceiveInfo& info)
     return;
   }
   if (!accept_time(msg.utime)) return;
-  poses_[msg.utime] = *pose;
-  while (poses_.size() > config_.pose_buffer) poses_.erase(poses_.begin());
+  // Evict by arrival, not by utime: after a backward step in time (within the clock's jump
+  // limit) the new poses are the earliest, and evicting the earliest dropped each at once.
+  if (poses_.insert_or_assign(msg.utime, *pose).second) pose_arrivals_.push_back(msg.utime);
+  while (poses_.size() > config_.pose_buffer) {
+    poses_.erase(pose_arrivals_.front());
+    pose_arrivals_.pop_front();
+  }
   // Depth frames that were waiting for this pose.
   for (auto it = pending_.begin(); it != pending_.end();) {
     if (std::llabs(it->first - msg.utime) <= config_.pose_tolerance_us) {

@@ -202,6 +202,27 @@ TEST(MapService, MatchesPosesByUtimeAndCountsBadInputs) {
   EXPECT_EQ(h.counter("frames_mapped"), 4);
 }
 
+TEST(MapService, PosesAfterABackwardStepInTimeAreKeptForMatching) {
+  m::MapServiceConfig cfg;
+  cfg.pose_buffer = 10;
+  Harness h(cfg);
+  const auto T = views()[0];
+  // A full buffer: 10 poses from 5.0 s.
+  for (int i = 0; i < 10; ++i) h.bus.publish("VO_POSE", h.pose_msg(5'000'000 + i * 50'000, T));
+  h.spin();
+  // Time steps back 2 s (within the 10 s jump limit, so not a new time base): the new poses are
+  // the earliest in the buffer, and the buffer evicts the oldest received, not the earliest.
+  for (int i = 0; i < 3; ++i) {
+    h.bus.publish("VO_POSE", h.pose_msg(3'000'000 + i * 50'000, T));
+    h.bus.publish("VO_DEPTH", h.depth_msg(3'000'000 + i * 50'000, T, false));
+  }
+  h.spin();
+  EXPECT_EQ(h.counter("VO.time_jumps"), 0);
+  EXPECT_EQ(h.counter("pose_from_vo"), 3);
+  EXPECT_EQ(h.counter("frames_mapped"), 3);
+  EXPECT_EQ(h.counter("depth_waiting_for_pose"), 0);
+}
+
 TEST(MapService, RecoversFromA25SecondOutageAndARestartAndReportsTheOutage) {
   // Issue 20: after any VO outage longer than 10 s (and after one bogus future utime) the map
   // dropped every VO_POSE/VO_DEPTH for good as "N s ahead of the newest message". Lock-step:
