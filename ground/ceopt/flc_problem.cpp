@@ -58,8 +58,9 @@ void FlcTuningProblem::repair(std::vector<double>& x) const {
     }
     free[v.name].emplace_back(k, j);
   }
-  for (auto& [name, sets] : free) {
-    const flc::Variable& v = base_.variable(name);
+  for (auto& entry : free) {  // not a structured binding: the lambda below captures `sets` (clang 14)
+    const flc::Variable& v = base_.variable(entry.first);
+    auto& sets = entry.second;
     const double gap = kMinGapFraction * (v.max - v.min);
     std::vector<double> pos(v.positions.begin(), v.positions.begin() + v.size() / 2);  // left side
     std::vector<double> values;
