@@ -15,6 +15,17 @@ namespace fs = std::filesystem;
 static const char* kEuroc = "stereo_seq/EuRoC_V1_01_easy_f000-094";
 static const char* kKitti = "stereo_seq/KITTI_odom_06_f000-050";
 
+// An undistorted rectified pair: focal length f, principal point at the centre, the right
+// camera `baseline` metres to the left camera's right.
+static StereoCalibration pinhole_pair(int width, int height, double f, double baseline) {
+  StereoCalibration c;
+  c.left = {width, height, f, f, width / 2.0, height / 2.0, Distortion::None, {}};
+  c.right = c.left;
+  c.T_right_left = aerie::geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-baseline, 0, 0));
+  c.source = "test";
+  return c;
+}
+
 TEST(Calibration, ReadsEurocSensorYaml) {
   AERIE_REQUIRE_DATA(kEuroc);
   const auto cam = read_euroc_camera(aerie::test::shared_data(kEuroc) / "mav0/cam0/sensor.yaml");
@@ -166,18 +177,9 @@ TEST(Calibration, MalformedOpenCvYamlIsRefusedNotHung) {
 TEST(Calibration, ImageSizesNoCameraHasAreRefused) {
   // The reader bounds its ints, but the rectifier allocates maps per pixel: 65535 x 65535 would
   // ask for tens of GB on a calibration file alone.
-  StereoCalibration c;
-  c.left = {640, 480, 500, 500, 320, 240, Distortion::None, {}};
-  c.right = c.left;
-  c.T_right_left = aerie::geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.1, 0, 0));
-  c.source = "test";
   const auto dir = aerie::test::scratch_dir("huge");
   for (const auto& [w, h] : {std::pair{16385, 100}, std::pair{100, 65535}, std::pair{9000, 8000}}) {
-    c.left.width = c.right.width = w;
-    c.left.height = c.right.height = h;
-    c.left.cx = c.right.cx = w / 2.0;
-    c.left.cy = c.right.cy = h / 2.0;
-    write_opencv_stereo(c, dir / "stereo.yaml");
+    write_opencv_stereo(pinhole_pair(w, h, 500, 0.1), dir / "stereo.yaml");
     try {
       read_stereo_calibration((dir / "stereo.yaml").string());
       FAIL() << w << "x" << h << " accepted";
@@ -187,17 +189,11 @@ TEST(Calibration, ImageSizesNoCameraHasAreRefused) {
           << e.what();
     }
   }
-  c.left.width = c.right.width = 8192;  // 8192 x 8192 = 2^26 pixels: the largest accepted
-  c.left.height = c.right.height = 8192;
-  EXPECT_NO_THROW(c.validate());
+  EXPECT_NO_THROW(pinhole_pair(8192, 8192, 500, 0.1).validate());  // 2^26 pixels: the largest accepted
 }
 
 TEST(Calibration, OpenCvYamlWithoutDistortionRoundTrips) {
-  StereoCalibration c;
-  c.left = {376, 240, 300, 300, 188, 120, Distortion::None, {}};
-  c.right = c.left;
-  c.T_right_left = aerie::geometry::SE3(Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.11, 0, 0));
-  c.source = "test";
+  const StereoCalibration c = pinhole_pair(376, 240, 300, 0.11);
   const auto file = aerie::test::scratch_dir("yaml") / "plain.yaml";
   write_opencv_stereo(c, file);
   const auto r = read_stereo_calibration(file);
