@@ -109,7 +109,7 @@ class MapService {
   OccupancyMap map_;
   DistanceMap distances_;
   std::map<int64_t, geometry::SE3> poses_;         // VO_POSE by utime
-  std::deque<int64_t> pose_arrivals_;              // their utimes in the order received (the buffer evicts the oldest received)
+  std::deque<int64_t> pose_arrivals_;              // their utimes as received: the buffer evicts the oldest received
   std::deque<std::pair<int64_t, spherical::SphericalDepth>> pending_;  // (utime, depth) waiting for VO_POSE
   util::NodeClock now_;
   bus::InputClock vo_clock_;                       // VO_POSE + VO_DEPTH: one time base
