@@ -6,9 +6,15 @@
 
 namespace aerie::pilot {
 
+bool AxisGains::valid() const {
+  for (double v : {kp, ki, kd, ku, integral_limit, output_limit})
+    if (!std::isfinite(v)) return false;
+  return kp >= 0 && ki >= 0 && kd >= 0 && ku > 0 && integral_limit > 0 && output_limit > 0;
+}
+
 AxisController::AxisController(const AxisGains& g) : g_(g) {
-  if (!(g.kp >= 0 && g.ki >= 0 && g.kd >= 0 && g.ku > 0 && g.integral_limit > 0 && g.output_limit > 0))
-    throw std::invalid_argument("axis gains: kp, ki, kd must be >= 0; ku, integral_limit, output_limit > 0");
+  if (!g.valid())
+    throw std::invalid_argument("axis gains: finite; kp, ki, kd >= 0; ku, integral_limit, output_limit > 0");
 }
 
 double AxisController::update(double t_s, double error) {

@@ -19,6 +19,8 @@ struct AxisGains {
   double ku = 1;                  // FLC output factor (unused by the PID)
   double integral_limit = 1;      // |integral of the error| <= this (anti-windup)
   double output_limit = 1;        // |command| <= this
+  // Finite; kp, ki, kd >= 0; ku, integral_limit, output_limit > 0.
+  bool valid() const;
 };
 
 class AxisController {

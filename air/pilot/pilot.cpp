@@ -48,6 +48,11 @@ void PilotConfig::validate() const {
   need(stale_timeout_s > 0 && control_period_s > 0 && abort_climb_s >= 0 && hold_climb_max_s >= 0,
        "stale_timeout_s and control_period_s must be > 0");
   for (const auto& leg : survey_legs) need(leg.allFinite(), "survey legs must be finite");
+  const std::pair<const char*, const AxisGains*> axes[] = {{"forward", &forward}, {"left", &left}, {"up", &up}, {"yaw", &yaw}};
+  for (const auto& [axis, g] : axes)
+    if (!g->valid())
+      throw std::invalid_argument("pilot config: gains." + controller + "." + axis +
+                                  ": finite; kp, ki, kd >= 0; ku, integral_limit, output_limit > 0");
 }
 
 Pilot::Pilot(PilotConfig config) : cfg_(std::move(config)) {

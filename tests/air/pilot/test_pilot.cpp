@@ -334,4 +334,11 @@ TEST(Pilot, BadInputsAreRefusedWithAReason) {
   }
   EXPECT_THROW(load_pilot_config(aerie::util::Config::parse("approach: {hieght_m: 2}\ngains: {fuzzy: {}}\n")),
                std::runtime_error);
+  // A gain that would make no controller is refused with the config, naming its axis.
+  try {
+    load_pilot_config(aerie::util::Config::parse("gains: {fuzzy: {left: {ku: -0.5}}}\n"));
+    FAIL() << "accepted a negative output factor";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("gains.fuzzy.left"), std::string::npos) << e.what();
+  }
 }
