@@ -2,12 +2,16 @@
 // prunes it, flies the avoidance experiment of 5.1.6 and writes the controllers (YAML,
 // FLL) and a report with plots. Progress goes to the terminal and to CE_PROGRESS;
 // the chosen controller can be sent to aerie-control on FLC_PARAMS.
+// `aerie-ceopt landing` tunes aerie-pilot's landing controller the same way, each candidate
+// flown in lock-step landings (ground/ceopt/landing_tuning.hpp), and writes a pilot.yaml.
 #include <aerie/ce_progress_t.hpp>
 #include <aerie/flc_params_t.hpp>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <sstream>
 
 #include "common/bus/bus.hpp"
@@ -17,6 +21,7 @@
 #include "common/flc/flc_io.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/time.hpp"
+#include "ground/ceopt/landing_tuning.hpp"
 #include "ground/ceopt/pipeline.hpp"
 #include "ground/ceopt/report.hpp"
 #include "ground/ceopt/thread_pool.hpp"
@@ -63,17 +68,49 @@ int main(int argc, char** argv) {
   app.add_option("--params-channel", params_channel, "channel for aerie.flc_params_t");
   app.add_option("--publish", publish, "controller to send on the params channel at the end")
       ->check(CLI::IsMember({"none", "sf", "sfmf", "pruned"}));
+  int training = -1, validation = -1;
+  CLI::App* landing = app.add_subcommand(
+      "landing",
+      "tune aerie-pilot's landing controller instead, in lock-step closed-loop landings (config/ceopt_landing.yaml; the "
+      "options above before or after the word, --runs excepted); writes OUT/pilot.yaml, report.md and CSVs");
+  landing->fallthrough();
+  landing->add_option("--training", training, "training seeds per candidate (overrides training.count)")->check(CLI::PositiveNumber);
+  landing->add_option("--validation", validation, "validation seeds (overrides validation.count; 0 = none)")
+      ->check(CLI::NonNegativeNumber);
+  std::string node_log_level = "warn";
+  landing->add_option("--node-log-level", node_log_level, "the flown nodes' log level (info shows every pilot transition)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   CLI11_PARSE(app, argc, argv);
   util::init_logging("ceopt", common.log_level);
+  // The tuning's own progress; in landing mode the nodes flown log through the default
+  // logger at --node-log-level (their transitions would flood the terminal).
+  std::shared_ptr<spdlog::logger> log = spdlog::default_logger();
+  if (landing->parsed()) {
+    log = log->clone("ceopt");
+    spdlog::default_logger()->set_level(spdlog::level::from_str(node_log_level));
+  }
 
   try {
-    CeoptConfig cfg = common.config.empty() ? default_ceopt_config() : ceopt_config_from(util::Config::load(common.config));
-    if (seed >= 0) cfg.ce.seed = static_cast<uint64_t>(seed);
-    if (threads >= 0) cfg.threads = threads;
-    if (iterations > 0) cfg.ce.max_iterations = iterations;
-    if (samples > 0) cfg.ce.samples = samples;
-    if (runs > 0) cfg.evaluation.runs_per_speed = runs;
-    cfg.ce.validate();
+    const bool landing_mode = landing->parsed();
+    if (landing_mode && runs > 0) throw std::runtime_error("--runs is the avoidance experiment's; landing uses --training/--validation");
+    CeoptConfig cfg;
+    LandingTuningConfig landing_cfg;
+    if (landing_mode) {
+      landing_cfg = common.config.empty() ? default_landing_tuning_config()
+                                          : landing_tuning_config_from(util::Config::load(common.config));
+      if (training > 0) landing_cfg.training.count = training;
+      if (validation >= 0) landing_cfg.validation.count = validation;
+    } else {
+      cfg = common.config.empty() ? default_ceopt_config() : ceopt_config_from(util::Config::load(common.config));
+      if (runs > 0) cfg.evaluation.runs_per_speed = runs;
+    }
+    CeOptions& ce = landing_mode ? landing_cfg.ce : cfg.ce;
+    int& pool_threads = landing_mode ? landing_cfg.threads : cfg.threads;
+    if (seed >= 0) ce.seed = static_cast<uint64_t>(seed);
+    if (threads >= 0) pool_threads = threads;
+    if (iterations > 0) ce.max_iterations = iterations;
+    if (samples > 0) ce.samples = samples;
+    ce.validate();
 
     std::unique_ptr<bus::Bus> lcm;
     std::unique_ptr<bus::StatusReporter> status;
@@ -86,21 +123,23 @@ int main(int argc, char** argv) {
       }
     }
     bus::install_stop_handlers();
-    ThreadPool pool(cfg.threads);
+    ThreadPool pool(pool_threads);
     std::ostringstream cmdline;
     for (int i = 0; i < argc; ++i) cmdline << (i ? " " : "") << argv[i];
-    spdlog::info("{} threads; CE N = {}, N_elite = {}, {} iterations per stage, {} training runs per candidate; load {}",
-                 pool.size(), cfg.ce.samples, cfg.ce.elite, cfg.ce.max_iterations,
-                 cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed), read_loadavg());
+    log->info("{} threads; CE N = {}, N_elite = {}, {} iterations per stage, {} training runs per candidate; load {}",
+                 pool.size(), ce.samples, ce.elite, ce.max_iterations,
+                 landing_mode ? static_cast<size_t>(landing_cfg.training.count)
+                              : cfg.training.speeds.size() * static_cast<size_t>(cfg.training.runs_per_speed),
+                 read_loadavg());
 
-    const std::string run_id = "ceopt-seed" + std::to_string(cfg.ce.seed);
+    const std::string run_id = std::string(landing_mode ? "ceopt-landing-seed" : "ceopt-seed") + std::to_string(ce.seed);
     int64_t seq = 0;
     const util::Stopwatch watch;
     auto on_iteration = [&](int stage, const std::vector<std::string>& names, const CeIteration& it) {
       std::ostringstream sig;
       for (size_t j = 0; j < names.size(); ++j) sig << " " << names[j] << "=" << it.mean[j] << "±" << it.sigma[j];
-      spdlog::info("stage {} iter {:3d}/{}  best {:.1f}  iter-best {:.1f}  eta {:.3f} |{}  ({:.1f} s)", stage, it.iteration,
-                   cfg.ce.max_iterations, it.best_cost, it.iteration_best_cost, it.eta, sig.str(), watch.ms() / 1000);
+      log->info("stage {} iter {:3d}/{}  best {:.4g}  iter-best {:.4g}  eta {:.3f} |{}  ({:.1f} s)", stage, it.iteration,
+                   ce.max_iterations, it.best_cost, it.iteration_best_cost, it.eta, sig.str(), watch.ms() / 1000);
       if (lcm) {
         aerie::ce_progress_t m;
         m.utime = util::wall_utime();
@@ -120,12 +159,35 @@ int main(int argc, char** argv) {
         lcm->publish(progress_channel, m);
         status->set("stage", stage);
         status->set("iteration", it.iteration);
-        status->count("evaluations", cfg.ce.samples);
+        status->count("evaluations", ce.samples);
         status->ok("stage " + std::to_string(stage) + " iteration " + std::to_string(it.iteration));
         status->tick();
       }
       return !bus::stop_requested();
     };
+
+    if (landing_mode) {
+      const LandingTuning problem(landing_cfg);
+      if (pool.size() > 1) cv::setNumThreads(1);  // one core per landing
+      const auto names = problem.names();
+      int candidates = 0;
+      auto on_candidate = [&](const std::vector<double>& x, const std::vector<LandingRun>& runs, double cost) {
+        std::ostringstream gains;
+        for (size_t j = 0; j < names.size(); ++j) gains << " " << names[j] << "=" << x[j];
+        const auto ok = std::count_if(runs.begin(), runs.end(), [](const LandingRun& r) { return r.success; });
+        log->info("candidate {:3d}: cost {:.4f}, {}/{} landed in bounds |{}", ++candidates, cost, ok, runs.size(), gains.str());
+      };
+      const LandingTuningResult result =
+          tune_landing(problem, pool, [&](const CeIteration& it) { return on_iteration(1, names, it); }, on_candidate);
+      const auto files = write_landing_report(out, problem, result, cmdline.str());
+      log->info("best training cost {:.4f} (initial {:.4f}) after {} candidates in {:.0f} s ({:.0f} s CPU); wrote {} files to {}",
+                   result.ce.best_cost, mean_cost(result.initial_training, landing_cfg), result.ce.evaluations, result.seconds,
+                   result.cpu_seconds, files.size(), out);
+      const bool interrupted = result.ce.stop_reason == "cancelled";
+      if (interrupted) log->warn("interrupted after iteration {}: the best so far is written, not validated", result.ce.history.size());
+      if (status) status->publish_now();
+      return interrupted ? 130 : 0;
+    }
 
     ReportInputs in;
     in.config = &cfg;

@@ -12,7 +12,6 @@
 #include "ground/ceopt/thread_pool.hpp"
 
 namespace aerie::ceopt {
-namespace {
 
 double process_cpu_seconds() {
   rusage u{};
@@ -20,7 +19,25 @@ double process_cpu_seconds() {
   return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-std::vector<CeParameter> parameters_from(const util::Config& cfg, const std::string& key, std::vector<CeParameter> fallback) {
+CeOptions ce_options_from(const util::Config& ce, CeOptions options) {
+  sim::require_known_keys(ce, {"samples", "elite", "iterations", "alpha", "beta", "q", "sigma_stop", "seed"});
+  options.samples = ce.get("samples", options.samples);
+  options.elite = ce.get("elite", options.elite);
+  options.max_iterations = ce.get("iterations", options.max_iterations);
+  options.alpha = ce.get("alpha", options.alpha);
+  options.beta = ce.get("beta", options.beta);
+  options.q = ce.get("q", options.q);
+  options.sigma_stop = ce.get("sigma_stop", options.sigma_stop);
+  options.seed = ce.get<uint64_t>("seed", options.seed);
+  try {
+    options.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(ce.origin() + ": " + e.what());
+  }
+  return options;
+}
+
+std::vector<CeParameter> ce_parameters_from(const util::Config& cfg, const std::string& key, std::vector<CeParameter> fallback) {
   if (!cfg.has(key)) return fallback;
   const YAML::Node list = cfg.node()[key];
   if (!list.IsSequence()) throw std::runtime_error(cfg.origin() + ": '" + key + "' must be a list of {name, mean, sigma, lower, upper}");
@@ -42,8 +59,6 @@ std::vector<CeParameter> parameters_from(const util::Config& cfg, const std::str
   return out;
 }
 
-}  // namespace
-
 CeoptConfig default_ceopt_config() {
   CeoptConfig c;
   // Stage 1 from the hand-tuned factors (all 1, thesis 5.1.3).
@@ -64,21 +79,7 @@ CeoptConfig ceopt_config_from(const util::Config& cfg) {
   c.controller = cfg.get<std::string>("controller", "");
   c.threads = cfg.get("threads", 0);
 
-  const auto ce = cfg.section("ce");
-  sim::require_known_keys(ce, {"samples", "elite", "iterations", "alpha", "beta", "q", "sigma_stop", "seed"});
-  c.ce.samples = ce.get("samples", c.ce.samples);
-  c.ce.elite = ce.get("elite", c.ce.elite);
-  c.ce.max_iterations = ce.get("iterations", c.ce.max_iterations);
-  c.ce.alpha = ce.get("alpha", c.ce.alpha);
-  c.ce.beta = ce.get("beta", c.ce.beta);
-  c.ce.q = ce.get("q", c.ce.q);
-  c.ce.sigma_stop = ce.get("sigma_stop", c.ce.sigma_stop);
-  c.ce.seed = ce.get<uint64_t>("seed", c.ce.seed);
-  try {
-    c.ce.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(ce.origin() + ": " + e.what());
-  }
+  c.ce = ce_options_from(cfg.section("ce"), c.ce);
 
   c.training.scenario = sim::avoidance_config_from(cfg.section("scenario"));
   const auto tr = cfg.section("training");
@@ -94,8 +95,8 @@ CeoptConfig ceopt_config_from(const util::Config& cfg) {
   c.training.limits.max_yaw_rate_deg_s = lim.get("max_yaw_rate_deg_s", c.training.limits.max_yaw_rate_deg_s);
   c.training.limits.max_yaw_accel_deg_s2 = lim.get("max_yaw_accel_deg_s2", c.training.limits.max_yaw_accel_deg_s2);
 
-  c.stage1 = parameters_from(cfg, "stage1", c.stage1);
-  c.stage2 = parameters_from(cfg, "stage2", c.stage2);
+  c.stage1 = ce_parameters_from(cfg, "stage1", c.stage1);
+  c.stage2 = ce_parameters_from(cfg, "stage2", c.stage2);
   const auto pr = cfg.section("prune");
   sim::require_known_keys(pr, {"overlap_fraction", "max_cost_increase"});
   c.prune.overlap_fraction = pr.get("overlap_fraction", c.prune.overlap_fraction);

@@ -36,6 +36,17 @@ struct CeoptConfig {
   EvaluationOptions evaluation;
 };
 
+// CPU time of this process so far, every thread (s).
+double process_cpu_seconds();
+
+// The `ce:` section (samples, elite, iterations, alpha, beta, q, sigma_stop, seed) over
+// `options`; throws naming the file and what is wrong.
+CeOptions ce_options_from(const util::Config& ce, CeOptions options);
+
+// The list `key` of {name, mean, sigma, lower, upper} (CE parameters); fallback when absent.
+// Throws naming the file and the entry.
+std::vector<CeParameter> ce_parameters_from(const util::Config& cfg, const std::string& key, std::vector<CeParameter> fallback);
+
 // Defaults = the thesis setting (config/ceopt.yaml documents every key).
 CeoptConfig default_ceopt_config();
 CeoptConfig ceopt_config_from(const util::Config& cfg);
