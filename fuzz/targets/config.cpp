@@ -7,7 +7,7 @@
 // unless `camera.calibration` names a file), aerie-vo (load_vo_node_config and the odometry's
 // validate), aerie-capture (load_capture_config), aerie-sim (load_simulation_config),
 // aerie-flightsim (load_flight_config, which validates) and aerie-ceopt (ceopt_config_from,
-// unless `controller` names a file).
+// unless `controller` names a file; landing_tuning_config_from).
 #include "air/capture/capture_node.hpp"
 #include "air/control/control_config.hpp"
 #include "air/nav/nav_config.hpp"
@@ -18,6 +18,7 @@
 #include "common/sim/sim_config.hpp"
 #include "common/util/config.hpp"
 #include "fuzz/fuzz_support.hpp"
+#include "ground/ceopt/landing_tuning.hpp"
 #include "ground/ceopt/pipeline.hpp"
 #include "ground/map/map_service.hpp"
 #include "tools/link/link_config.hpp"
@@ -72,5 +73,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::refusal_ok([&] {
     if (cfg.get<std::string>("controller", "").empty()) ceopt::ceopt_config_from(cfg);
   });
+  fuzz::refusal_ok([&] { ceopt::landing_tuning_config_from(cfg); });
   return 0;
 }
