@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <sstream>
 
 #include "air/pilot/pilot_config.hpp"
@@ -119,6 +120,7 @@ TEST(LandingTuning, ATuningInTheClosedLoopIsReproducibleAndWritesAPilotConfig) {
   cfg.ce.max_iterations = 1;
   const LandingTuning problem(cfg);
   ThreadPool pool(2);
+  cv::setNumThreads(1);  // as aerie-ceopt does with a pool of several threads: one core per landing
   const LandingTuningResult r = tune_landing(problem, pool);
   ASSERT_EQ(r.ce.history.size(), 1u);
   EXPECT_EQ(r.ce.evaluations, 2);
