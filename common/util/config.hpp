@@ -19,6 +19,15 @@ namespace aerie::util {
 class Config {
  public:
   Config() = default;  // empty: every get() returns its default
+  // A copy shares the (read-only) document; assignment rebinds to the other's document.
+  // yaml-cpp's Node::operator= writes through a shared node instead: it would change every
+  // copy of the document, in every thread that holds one.
+  Config(const Config&) = default;
+  Config& operator=(const Config& other) {
+    root_.reset(other.root_);
+    origin_ = other.origin_;
+    return *this;
+  }
   static Config load(const std::string& path);
   static Config parse(const std::string& text, const std::string& origin = "<string>");
 

@@ -103,3 +103,24 @@ TEST(Config, ErrorsNameTheLineOfANestedKey) {
   EXPECT_FALSE(c.has("a.x"));  // a lookup inserts nothing
   EXPECT_EQ(error_of([&] { c.check_keys({"a.b.c", "a.b.d"}); }), "");
 }
+
+// A copy shares the document of the Config it was copied from; assigning another Config to
+// the copy must rebind it, not write through into the shared document (yaml-cpp's own
+// Node::operator= does: every copy of the original, in any thread, would change with it).
+// aerie-linkstudy --jobs 2 crashed in yaml-cpp that way: each flight assigned new node options
+// to its copy of the study's, and the two threads rewrote the study's document at once.
+TEST(Config, AssigningToACopyLeavesTheOriginalAsItWas) {
+  const Config original = Config::parse("x: 1\nsection: {y: 2}\n", "original.yaml");
+  Config copy = original;
+  copy = Config::parse("x: 5\n", "other.yaml");
+  EXPECT_EQ(copy.get<int>("x", 0), 5);
+  EXPECT_EQ(copy.origin(), "other.yaml");
+  EXPECT_EQ(original.get<int>("x", 0), 1);
+  EXPECT_EQ(original.get<int>("section.y", 0), 2);
+  Config part = original.section("section");
+  part = Config();
+  EXPECT_FALSE(part.has("y"));
+  EXPECT_EQ(original.get<int>("section.y", 0), 2);
+  copy = original;  // and back: the same document again
+  EXPECT_EQ(copy.get<int>("section.y", 0), 2);
+}
