@@ -5,9 +5,10 @@ the landings of that configuration (the mean over the landed runs, as in summary
 number of runs when the configurations differ in it.
    landing_matrix.py LANDINGS.csv [LANDINGS.csv ...] > matrix.md
 A configuration that appears in two files (the same seed twice) is refused."""
-import csv
 import sys
 from collections import defaultdict
+
+from plot_landing import mean, rows, success_and_errors
 
 
 def main(paths):
@@ -15,17 +16,16 @@ def main(paths):
     winds = set()
     seen = set()
     for path in paths:
-        with open(path, newline="") as f:
-            for r in csv.DictReader(f):
-                conf = (r["tracker"], r["controller"], r["world"], r["vibration"])
-                wind = float(r["wind_m_s"])
-                run = conf + (wind, r["seed"])
-                if run in seen:
-                    sys.exit(f"landing_matrix.py: {path}: seed {r['seed']} of {' '.join(conf)} wind {wind:g} "
-                             "appears twice")
-                seen.add(run)
-                runs[conf + (wind,)].append(r)
-                winds.add(wind)
+        for r in rows(path):
+            conf = (r["tracker"], r["controller"], r["world"], r["vibration"])
+            wind = float(r["wind_m_s"])
+            run = conf + (wind, r["seed"])
+            if run in seen:
+                sys.exit(f"landing_matrix.py: {path}: seed {r['seed']} of {' '.join(conf)} wind {wind:g} "
+                         "appears twice")
+            seen.add(run)
+            runs[conf + (wind,)].append(r)
+            winds.add(wind)
     winds = sorted(winds)
     counts = {len(rs) for rs in runs.values()}
     print("| tracker | controller | world | vibration | "
@@ -38,10 +38,8 @@ def main(paths):
             if not rs:
                 cells.append("–")
                 continue
-            ok = sum(int(r["success"]) for r in rs)
-            err = [100 * float(r["touchdown_error_m"]) for r in rs if r["landed"] == "1"]
-            mean = sum(err) / len(err) if err else float("nan")
-            cells.append(f"{100 * ok / len(rs):.0f} % / {mean:.1f}" + (f" ({len(rs)} runs)" if len(counts) > 1 else ""))
+            ok, err = success_and_errors(rs)
+            cells.append(f"{100 * ok / len(rs):.0f} % / {mean(err):.1f}" + (f" ({len(rs)} runs)" if len(counts) > 1 else ""))
         print(f"| {' | '.join(conf)} | " + " | ".join(cells) + " |")
 
 

@@ -7,15 +7,20 @@ import csv
 import sys
 from collections import defaultdict
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
 
 def rows(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
+
+
+def success_and_errors(rs):
+    """Successful runs among rs, and the sorted touchdown errors (cm) of those that landed."""
+    ok = sum(int(r["success"]) for r in rs)
+    return ok, sorted(100 * float(r["touchdown_error_m"]) for r in rs if r["landed"] == "1")
+
+
+def mean(v):
+    return sum(v) / len(v) if v else float("nan")
 
 
 def key(r):
@@ -35,11 +40,9 @@ def table(landings, descent):
            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for k in sorted(runs):
         rs = runs[k]
-        ok = sum(int(r["success"]) for r in rs)
+        ok, err = success_and_errors(rs)
         landed = [r for r in rs if r["landed"] == "1"]
-        err = sorted(100 * float(r["touchdown_error_m"]) for r in landed)
         p95 = err[min(len(err) - 1, max(0, -(-95 * len(err) // 100) - 1))] if err else float("nan")
-        mean = lambda v: sum(v) / len(v) if v else float("nan")
         fitted = [r for r in desc[k] if r.get("fitted", "1") == "1"]
         rmse = lambda col, rs=desc[k]: mean([float(r[col]) ** 2 for r in rs]) ** 0.5
         box = 100 * (1 - len(fitted) / len(desc[k])) if desc[k] else float("nan")
@@ -54,6 +57,11 @@ def table(landings, descent):
 
 
 def main(out):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     landings = rows(f"{out}/landings.csv")
     descent = rows(f"{out}/descent.csv")
     with open(f"{out}/summary.md", "w") as f:
