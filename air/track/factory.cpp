@@ -175,6 +175,7 @@ void read_correlation_filter(Params& in, P& p) {
   in.read("scale_lambda", p.scale_lambda);
   in.read("scale_learning_rate", p.scale_learning_rate);
   in.read_in("scale_model_area", p.scale_model_area, 16.0, 65536.0);
+  in.read("scale_resize_once", p.scale_resize_once);
   in.read("min_scale", p.min_scale);
   in.read("max_scale", p.max_scale);
   in.read("update_confidence", p.update_confidence);

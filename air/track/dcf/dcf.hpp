@@ -56,6 +56,7 @@ struct DcfParams {
   double scale_lambda = 1e-2;
   double scale_learning_rate = 0.025;
   double scale_model_area = 1024;  // scale samples are resized to this many pixels
+  bool scale_resize_once = false;  // the samples from one resized region (ScaleFilterParams::resize_once)
   double min_scale = 0.2, max_scale = 5;  // relative to the initial box
   // Occlusion. Confidence = min(peak, APCE) of the filter relative to their running means:
   // below update_confidence the models are not updated and the state says lost.
@@ -70,7 +71,7 @@ struct DcfParams {
   void validate() const;  // throws std::invalid_argument naming the bad value
   AdmmSettings admm() const { return {lambda, admm_iterations, admm_mu, admm_beta, admm_mu_max}; }
   ScaleFilterParams scale_filter() const {
-    return {scales, scale_step, scale_sigma, scale_lambda, scale_model_area, cell};
+    return {scales, scale_step, scale_sigma, scale_lambda, scale_model_area, cell, scale_resize_once};
   }
 };
 

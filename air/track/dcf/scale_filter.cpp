@@ -1,6 +1,7 @@
 #include "air/track/dcf/scale_filter.hpp"
 
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 #include "air/track/dcf/fhog.hpp"
 #include "air/track/dcf/window.hpp"
@@ -23,9 +24,25 @@ ScaleFilter::ScaleFilter(const ScaleFilterParams& p, cv::Size2d target) : p_(p),
 }
 
 cv::Mat ScaleFilter::features(const cv::Mat& frame, cv::Point2d pos, double scale) const {
+  const cv::Size2d unit = target_ * scale;  // the sample of factor 1, image pixels
+  cv::Mat region;                           // with resize_once: the largest sample's region at the model's resolution
+  if (p_.resize_once) {
+    const cv::Size size(cvCeil(model_.width * factors_.front()) + 2, cvCeil(model_.height * factors_.front()) + 2);
+    region = subwindow(frame, pos, {size.width * unit.width / model_.width, size.height * unit.height / model_.height},
+                       size);
+  }
   cv::Mat xs;  // feature dimension x scales
   for (int i = 0; i < p_.scales; ++i) {
-    const cv::Mat patch = subwindow(frame, pos, target_ * (scale * factors_[i]), model_);
+    cv::Mat patch;
+    if (region.empty()) {
+      patch = subwindow(frame, pos, target_ * (scale * factors_[i]), model_);
+    } else {
+      // Output pixel u samples the region at its centre + (u + 1/2 - model / 2) * factor - 1/2.
+      const double f = factors_[i];
+      const cv::Matx23d to_region(f, 0, region.cols / 2.0 - 0.5 + (0.5 - model_.width / 2.0) * f,  //
+                                  0, f, region.rows / 2.0 - 0.5 + (0.5 - model_.height / 2.0) * f);
+      cv::warpAffine(region, patch, to_region, model_, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+    }
     const std::vector<cv::Mat> h = fhog(patch, p_.cell);
     const int cells = static_cast<int>(h[0].total());
     if (xs.empty()) xs.create(cells * static_cast<int>(h.size()), p_.scales, CV_32F);
@@ -41,12 +58,15 @@ cv::Mat ScaleFilter::features(const cv::Mat& frame, cv::Point2d pos, double scal
 }
 
 void ScaleFilter::learn(const cv::Mat& frame, cv::Point2d pos, double scale, double rate) {
-  filter_.learn(features(frame, pos, scale), yf_, rate);
+  const bool same = last_.frame == frame.data && last_.pos == pos && last_.scale == scale && !last_.xsf.empty();
+  filter_.learn(same ? last_.xsf : features(frame, pos, scale), yf_, rate);
+  last_ = {};
 }
 
-double ScaleFilter::best_change(const cv::Mat& frame, cv::Point2d pos, double scale) const {
+double ScaleFilter::best_change(const cv::Mat& frame, cv::Point2d pos, double scale) {
+  last_ = {frame.data, pos, scale, features(frame, pos, scale)};
   cv::Mat response;
-  cv::dft(filter_.respond(features(frame, pos, scale), p_.lambda), response,
+  cv::dft(filter_.respond(last_.xsf, p_.lambda), response,
           cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE | cv::DFT_ROWS);
   cv::Point best;
   cv::minMaxLoc(response, nullptr, nullptr, nullptr, &best);

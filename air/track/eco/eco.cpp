@@ -115,11 +115,14 @@ EcoTracker::Detection EcoTracker::detect(const cv::Mat& frame, cv::Point2d centr
   d.zf = spectra(projected(raw_features(d.patch, cells), cells));
   // Response spectrum sum_c G_c Z_c (the filters' convention: G = Y conj(X) / |X|^2).
   d.rf = cv::Mat(fw_.cells, CV_32FC2, cv::Scalar::all(0));
-  Complex* out = d.rf.ptr<Complex>();
+  float* out = d.rf.ptr<float>();  // interleaved re, im; g z in reals, as std::complex<float> computes it
   for (size_t c = 0; c < d.zf.size(); ++c) {
-    const Complex* z = d.zf[c].ptr<Complex>();
-    const Complex* g = filter_[c].ptr<Complex>();
-    for (size_t k = 0; k < d.rf.total(); ++k) out[k] += g[k] * z[k];
+    const float* z = d.zf[c].ptr<float>();
+    const float* g = filter_[c].ptr<float>();
+    for (size_t k = 0; k < d.rf.total(); ++k) {
+      out[2 * k] += g[2 * k] * z[2 * k] - g[2 * k + 1] * z[2 * k + 1];
+      out[2 * k + 1] += g[2 * k] * z[2 * k + 1] + g[2 * k + 1] * z[2 * k];
+    }
   }
   cv::dft(d.rf, d.response, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
   // Peak and average peak-to-correlation energy (APCE, Wang et al. 2017).
@@ -162,15 +165,19 @@ void EcoTracker::train() {
   const AdmmSettings admm{p_.lambda, p_.admm_iterations, 5, 3, 20};
   for (size_t c = 0; c < channels; ++c) {
     cv::Mat yx(fw_.cells, CV_32FC2, cv::Scalar::all(0)), sxx(fw_.cells, CV_32F, cv::Scalar(0));
-    Complex* a = yx.ptr<Complex>();
+    float* a = yx.ptr<float>();  // interleaved re, im
     float* e = sxx.ptr<float>();
     for (size_t m = 0; m < comps.size(); ++m) {
-      const Complex* x = comps[m].xf[c].ptr<Complex>();
-      const Complex* y = comps[m].yf.ptr<Complex>();
+      const float* x = comps[m].xf[c].ptr<float>();
+      const float* y = comps[m].yf.ptr<float>();
       const float wm = static_cast<float>(w[m]);
+      // (wm y) conj(x) and wm |x|^2 written out in reals (the operations of std::complex<float>,
+      // in its order), so that the compiler vectorises the loop.
       for (size_t k = 0; k < n; ++k) {
-        a[k] += wm * y[k] * std::conj(x[k]);
-        e[k] += wm * std::norm(x[k]);
+        const float tr = wm * y[2 * k], ti = wm * y[2 * k + 1], xr = x[2 * k], xi = x[2 * k + 1];
+        a[2 * k] += tr * xr - ti * -xi;
+        a[2 * k + 1] += tr * -xi + ti * xr;
+        e[k] += wm * (xr * xr + xi * xi);
       }
     }
     filter_[c] = masked_filter(yx, sxx, fw_.mask, admm);

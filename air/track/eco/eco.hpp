@@ -46,7 +46,7 @@ struct EcoParams {
   // Window and filter (as dcf).
   int cell = 4;                      // FHOG and colour-names cell, pixels of the resized window
   double padding = 2.0;              // window = target + padding * (w + h) / 2 per side
-  double template_area = 150 * 150;  // the window is resized to about this many pixels
+  double template_area = 200 * 200;  // the window is resized to about this many pixels
   double output_sigma = 1.0 / 16;    // Gaussian label sigma, x sqrt(target area) (in cells)
   double lambda = 1e-3;              // filter regularisation
   double mask_scale = 1.1;           // the filter's support is the target box times this
@@ -57,7 +57,7 @@ struct EcoParams {
   // Sample space and sparse updates (ECO-HC: 30 components, learning rate 0.009, N_s = 6).
   int samples = 30;
   double learning_rate = 0.01;
-  int update_interval = 6;           // frames between filter trainings
+  int update_interval = 3;           // frames between filter trainings
   // ARCF: the label is (y + aberrance * M_prev) / (1 + aberrance); 0 switches it off.
   double aberrance = 0.3;
   int newton_iterations = 5;
@@ -73,6 +73,7 @@ struct EcoParams {
   double scale_lambda = 1e-2;
   double scale_learning_rate = 0.025;
   double scale_model_area = 1024;
+  bool scale_resize_once = true;  // the samples from one resized region (ScaleFilterParams::resize_once)
   double min_scale = 0.2, max_scale = 5;
   // Loss. Confidence = min(peak, APCE) relative to their running means; below
   // update_confidence nothing is learned. The state says lost once the confidence has stayed
@@ -80,8 +81,8 @@ struct EcoParams {
   // detector in docs/results/track.md), until it is above again.
   double update_confidence = 0.3;
   double confidence_rate = 0.05;
-  double lost_confidence = 0.15;  // chosen on simulated exits (bench/track/lost_rule.py)
-  int lost_after = 3;
+  double lost_confidence = 0.25;  // chosen on simulated exits (bench/track/lost_rule.py)
+  int lost_after = 2;
   // Appearance verifier (verifier.hpp; TLD's conservative model, Kalal et al. 2012): the state
   // also says lost once the similarity (largest normalised cross-correlation of the box's grey
   // 16x16 patch with the exemplars) has stayed below verify_threshold for verify_after frames in
@@ -89,7 +90,7 @@ struct EcoParams {
   // confidence reaches verify_learn_confidence and whose similarity reaches
   // verify_learn_similarity, at most one every verify_interval frames, verify_exemplars at most
   // (the first kept, the oldest of the others replaced). It changes the LOST flag only.
-  double verify_threshold = 0.4;  // chosen on simulated exits (bench/track/lost_rule.py)
+  double verify_threshold = 0;  // off: chosen on simulated exits (bench/track/lost_rule.py); 0.4 was before 2026-11-27
   int verify_after = 5;
   int verify_exemplars = 8;
   double verify_learn_confidence = 0.9;
@@ -107,7 +108,7 @@ struct EcoParams {
 
   void validate() const;  // throws std::invalid_argument naming the bad value
   ScaleFilterParams scale_filter() const {
-    return {scales, scale_step, scale_sigma, scale_lambda, scale_model_area, cell};
+    return {scales, scale_step, scale_sigma, scale_lambda, scale_model_area, cell, scale_resize_once};
   }
 };
 

@@ -6,7 +6,8 @@
 // component whose weight fell below `min_weight` is replaced; otherwise, if the new sample is
 // nearer to its closest component than the two closest components are to each other, it is
 // merged into that component, else those two are merged (weighted means) and the new sample
-// takes the freed slot. The weights are kept normalised to sum 1.
+// takes the freed slot. The weights are kept normalised to sum 1. The distances come from a
+// Gram matrix of the components, updated from the new sample's inner products with them.
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -27,16 +28,20 @@ class SampleSpace {
   // Squared Euclidean distance of two samples' feature spectra (summed over channels), which
   // must be DFTs of real signals.
   static double distance(const Sample& a, const Sample& b);
+  // Real part of the inner product of the two samples' full spectra (summed over channels).
+  static double inner(const Sample& a, const Sample& b);
+  // Squared distance of components i and j as the Gram matrix holds it.
+  double distance(size_t i, size_t j) const;
 
  private:
   void merge_into(size_t into, const Sample& s, double w);  // weighted mean, weight summed
-  void update_distances(size_t k);                           // row and column k of distance_
+  void set_gram(size_t i, size_t j, double v);               // entries (i, j) and (j, i)
 
   int capacity_;
   double learning_rate_, min_weight_;
   std::vector<Sample> components_;
   std::vector<double> weights_;
-  cv::Mat distance_;  // capacity x capacity, CV_64F, between components
+  cv::Mat gram_;  // capacity x capacity, CV_64F: Re <component i, component j>
 };
 
 }  // namespace aerie::track

@@ -6,6 +6,7 @@
 
 #include "air/track/dcf/dcf.hpp"
 #include "air/track/dcf/fhog.hpp"
+#include "air/track/dcf/scale_filter.hpp"
 #include "tests/air/track/fhog_reference.hpp"
 #include "tests/air/track/synthetic.hpp"
 
@@ -184,8 +185,37 @@ TEST(Dcf, MaskedFilterIsTheConstrainedLeastSquaresFilter) {
   EXPECT_LT(cv::norm(g300, best, cv::NORM_INF), 1e-3 * cv::norm(best, cv::NORM_INF));
 }
 
-// On the frame it learned from, the filter's peak is at zero shift and the scale filter's at
-// scale 1: the box does not move.
+// DSST's scale filter learned on one frame finds the target's scale change in the next, taking
+// every sample from the frame or (resize_once) from one resized region: the same factor on the
+// training frame, and for shrinking and growing targets a change in the right direction within
+// two sample steps of the truth (one frame's filter and the Hann window along the scales pull
+// large changes towards 1: a tracker gets there over a few frames), the two samplings within a
+// step of each other.
+TEST(ScaleFilter, FindsTheScaleChangeWithEitherSampling) {
+  const test::Scene scene({320, 240}, {72, 48}, 5, 2.0);
+  const cv::Point2d centre(150.3, 118.6);
+  const cv::Mat first = scene.render({centre});
+  const std::vector<double> truths{0.9, 0.95, 1.04, 1.1, 1.16};
+  std::vector<double> found[2];
+  for (const bool once : {false, true}) {
+    ScaleFilterParams p;
+    p.resize_once = once;
+    ScaleFilter filter(p, scene.target_size());
+    filter.learn(first, centre, 1.0, 1.0);
+    EXPECT_DOUBLE_EQ(filter.best_change(first, centre, 1.0), 1.0) << "resize_once " << once;
+    for (const double truth : truths) {
+      Motion m{centre};
+      m.scale = truth;
+      found[once].push_back(filter.best_change(scene.render(m), centre, 1.0));
+      EXPECT_GT((found[once].back() - 1) * (truth - 1), 0) << "resize_once " << once << ", truth " << truth;
+      EXPECT_LE(std::abs(std::log(found[once].back() / truth)), 2.01 * std::log(p.step))
+          << "resize_once " << once << ", truth " << truth << ", found " << found[once].back();
+    }
+  }
+  for (size_t i = 0; i < truths.size(); ++i)
+    EXPECT_LE(std::abs(std::log(found[0][i] / found[1][i])), 1.01 * std::log(1.02)) << "truth " << truths[i];
+}
+
 TEST(Dcf, TheTrainingFrameGivesTheSameBox) {
   const Scene scene({240, 180}, {40, 32});
   Motion m;
