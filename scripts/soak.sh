@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The soak: the autonomous demo flight (scripts/demo.sh, config/demo.pmd) flown again and
 # again in real time by one long-running chain, its processes sampled once a second.
-#   bash scripts/soak.sh [--minutes N | --flights N] [--seed N] [--out DIR] [--warmup-minutes M]
+#   bash scripts/soak.sh [--minutes N | --flights N] [--seed N] [--same-seed] [--out DIR] [--warmup-minutes M]
 #                        [--netns] [--keep-log] [--bin DIR] [--recv-buf-size BYTES]
 #                        [--kill NODES] [--kill-window A:B]
 # One deputy and one logger (aerie-log record), aerie-map, aerie-viewer, aerie-vo and
 # aerie-track run the whole time; each flight restarts aerie-pilot (its mission ends LANDED)
-# and aerie-flightsim with the next seed (--seed, then +1 per flight), through a headless
+# and aerie-flightsim with the next seed (--seed, then +1 per flight; with --same-seed every
+# flight is --seed's: the same room and pad, so RSS compares like with like), through a headless
 # sheriff per flight. Between flights the tracker gets TRACK_CMD STOP, and INIT on the pad's
 # box when it comes into view (the operator's box), and the map MAP_CMD CLEAR (VO restarts
 # its frame with each flight): tools/soak/soak_monitor.py, which also samples RSS, CPU and
@@ -32,13 +33,14 @@ caller_pwd="${AERIE_SOAK_PWD:-$PWD}"  # paths in the options are relative to it
 cd "$(dirname "$0")/.."
 args=("$@")
 
-minutes=30 flights=0 seed=1 out="" warmup=3 netns=0 keep_log=0 BIN="" recv_buf="" kill_nodes=() kill_window=4:16
+minutes=30 flights=0 seed=1 same_seed=0 out="" warmup=3 netns=0 keep_log=0 BIN="" recv_buf="" kill_nodes=() kill_window=4:16
 number() { [[ "$2" =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "soak: $1 needs a number, not '$2'" >&2; exit 2; }; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --minutes) number "$1" "${2:-}"; minutes="$2"; shift 2 ;;
     --flights) [[ "${2:-}" =~ ^[1-9][0-9]*$ ]] || { echo "soak: --flights needs a count" >&2; exit 2; }; flights="$2"; shift 2 ;;
     --seed) [[ "${2:-}" =~ ^[0-9]+$ ]] || { echo "soak: --seed needs an integer" >&2; exit 2; }; seed="$2"; shift 2 ;;
+    --same-seed) same_seed=1; shift ;;
     --out) out="${2:-}"; [ -n "$out" ] || { echo "soak: --out needs a folder" >&2; exit 2; }; shift 2 ;;
     --warmup-minutes) number "$1" "${2:-}"; warmup="$2"; shift 2 ;;
     --netns) netns=1; shift ;;
@@ -235,7 +237,7 @@ while [ "$interrupted" = 0 ]; do
     awk "BEGIN{exit !($(elapsed) < $minutes * 60)}" || break
   fi
   n=$((n + 1))
-  s=$((seed + n - 1))
+  s=$((same_seed ? seed : seed + n - 1))
   tag=$(printf "%04d" "$n")
   result="$out/flights/$tag-result.txt"
   flight_pmd "$s" "$result" >"$out/pmd/flight-$tag.pmd"
@@ -301,7 +303,7 @@ else
   echo "soak: no log was written ($AERIE_LOG)" >&2
 fi
 cat >"$out/run.json" <<EOF
-{"minutes": $minutes, "flights_requested": $flights, "first_seed": $seed, "flights": $n, "duration_s": $t_end,
+{"minutes": $minutes, "flights_requested": $flights, "first_seed": $seed, "same_seed": $same_seed, "flights": $n, "duration_s": $t_end,
  "warmup_minutes": $warmup, "interrupted": $interrupted, "netns": "${AERIE_SOAK_NETNS:-}",
  "t0_epoch": $t0, "lcm_url": "$LCM_DEFAULT_URL", "load_start": "$load0", "load_end": "$load1", "host_cpus": $(nproc),
  "command": "${AERIE_SOAK_COMMAND:-scripts/soak.sh ${args[*]}}", "started_utc": "$(date -u -d "@${t0%.*}" '+%Y-%m-%d %H:%M:%S')"}

@@ -245,6 +245,7 @@ def main():
     if run:
         L.append(f"`{run.get('command', 'scripts/soak.sh')}` — started {run.get('started_utc', '?')} UTC, "
                  f"{t_end / 60:.1f} min, {len(flights)} flights from seed {run.get('first_seed', '?')}"
+                 f"{' (every flight the same seed)' if run.get('same_seed') else ''}"
                  f"{' (interrupted)' if run.get('interrupted') else ''}; {run.get('host_cpus', '?')} CPUs; "
                  f"load average {run.get('load_start', '?')} at the start, {run.get('load_end', '?')} at the end"
                  + (f", 1-min load {summary['load1_mean']:.1f} mean / {summary['load1_max']:.1f} max during the run"
