@@ -62,9 +62,12 @@ SampleSpace::SampleSpace(int capacity, double learning_rate, double min_weight)
   gram_ = cv::Mat(capacity, capacity, CV_64F, cv::Scalar(0));
 }
 
+double SampleSpace::gram(size_t i, size_t j) const {
+  return gram_.at<double>(static_cast<int>(i), static_cast<int>(j));
+}
+
 double SampleSpace::distance(size_t i, size_t j) const {
-  const auto g = [&](size_t a, size_t b) { return gram_.at<double>(static_cast<int>(a), static_cast<int>(b)); };
-  return i == j ? 0 : g(i, i) + g(j, j) - 2 * g(i, j);
+  return i == j ? 0 : gram(i, i) + gram(j, j) - 2 * gram(i, j);
 }
 
 void SampleSpace::set_gram(size_t i, size_t j, double v) {
@@ -124,7 +127,7 @@ void SampleSpace::add(const Sample& s) {
     size_t nearest = 0;
     double d_new = std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < n; ++k) {
-      const double d = ss + gram_.at<double>(static_cast<int>(k), static_cast<int>(k)) - 2 * p[k];
+      const double d = ss + gram(k, k) - 2 * p[k];
       if (d < d_new) d_new = d, nearest = k;
     }
     size_t a = 0, b = 1;
@@ -135,20 +138,19 @@ void SampleSpace::add(const Sample& s) {
     if (d_new < d_pair) {
       // m' = alpha m + beta s: <m', k> = alpha <m, k> + beta <s, k>.
       const double alpha = weights_[nearest] / (weights_[nearest] + w_new), beta = 1 - alpha;
-      const double mm = gram_.at<double>(static_cast<int>(nearest), static_cast<int>(nearest));
+      const double mm = gram(nearest, nearest);
       merge_into(nearest, s, w_new);
       for (size_t k = 0; k < n; ++k)
         if (k != nearest)
-          set_gram(nearest, k, alpha * gram_.at<double>(static_cast<int>(nearest), static_cast<int>(k)) + beta * p[k]);
+          set_gram(nearest, k, alpha * gram(nearest, k) + beta * p[k]);
       set_gram(nearest, nearest, alpha * alpha * mm + 2 * alpha * beta * p[nearest] + beta * beta * ss);
     } else {
       // a' = alpha a + beta b, then s takes b's slot.
       const double alpha = weights_[a] / (weights_[a] + weights_[b]), beta = 1 - alpha;
-      const auto g = [&](size_t i, size_t j) { return gram_.at<double>(static_cast<int>(i), static_cast<int>(j)); };
-      const double aa = alpha * alpha * g(a, a) + 2 * alpha * beta * g(a, b) + beta * beta * g(b, b);
+      const double aa = alpha * alpha * gram(a, a) + 2 * alpha * beta * gram(a, b) + beta * beta * gram(b, b);
       merge_into(a, components_[b], weights_[b]);
       for (size_t k = 0; k < n; ++k)
-        if (k != a && k != b) set_gram(a, k, alpha * g(a, k) + beta * g(b, k));
+        if (k != a && k != b) set_gram(a, k, alpha * gram(a, k) + beta * gram(b, k));
       set_gram(a, a, aa);
       p[a] = alpha * p[a] + beta * p[b];  // <s, a'>
       take_slot(b, w_new);

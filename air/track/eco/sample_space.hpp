@@ -35,6 +35,7 @@ class SampleSpace {
 
  private:
   void merge_into(size_t into, const Sample& s, double w);  // weighted mean, weight summed
+  double gram(size_t i, size_t j) const;
   void set_gram(size_t i, size_t j, double v);               // entries (i, j) and (j, i)
 
   int capacity_;
