@@ -6,10 +6,12 @@ set -euo pipefail
 
 usage() {
   cat <<'EOF'
-usage: scripts/fuzz.sh [--seconds N] [--runs R] [--target NAME]... [--jobs J] [--no-build]
+usage: scripts/fuzz.sh [--seconds N] [--runs R] [--fork F] [--target NAME]... [--jobs J] [--no-build]
 
   --seconds N    fuzzing time per target (default 600; with --runs, a ceiling)
   --runs R       stop each target after R executions (libFuzzer's -runs) or N seconds
+  --fork F       F fuzzing processes per target (libFuzzer's -fork; it ignores --runs, so
+                 stop on --seconds; the executions are the sum over the processes)
   --target NAME  run only this target (repeatable; default: every fuzz/targets/*.cpp)
   --jobs J       parallel compile jobs (default: nproc; use 1 on a shared machine)
   --no-build     run the targets already built in build/fuzz
@@ -28,6 +30,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=$root/build/fuzz
 seconds=600
 runs=-1
+fork=0
 jobs=$(nproc)
 do_build=1
 targets=()
@@ -36,6 +39,7 @@ while [ $# -gt 0 ]; do
     --seconds) seconds=${2:?--seconds needs a value}; shift 2 ;;
     --target) targets+=("${2:?--target needs a name}"); shift 2 ;;
     --runs) runs=${2:?--runs needs a value}; shift 2 ;;
+    --fork) fork=${2:?--fork needs a value}; shift 2 ;;
     --jobs) jobs=${2:?--jobs needs a value}; shift 2 ;;
     --no-build) do_build=0; shift ;;
     -h|--help) usage; exit 0 ;;
@@ -44,6 +48,9 @@ while [ $# -gt 0 ]; do
 done
 [[ $seconds =~ ^[0-9]+$ && $seconds -gt 0 ]] || { echo "fuzz.sh: --seconds must be a positive integer" >&2; exit 2; }
 [[ $runs = -1 || ( $runs =~ ^[0-9]+$ && $runs -gt 0 ) ]] || { echo "fuzz.sh: --runs must be a positive integer" >&2; exit 2; }
+[[ $fork =~ ^[0-9]+$ ]] || { echo "fuzz.sh: --fork must be a number of processes (0: no fork)" >&2; exit 2; }
+fork_args=()
+[ "$fork" -gt 0 ] && fork_args=(-fork="$fork" -ignore_crashes=0)
 if [ ${#targets[@]} -eq 0 ]; then
   for f in "$root"/fuzz/targets/*.cpp; do targets+=("$(basename "$f" .cpp)"); done
 fi
@@ -79,7 +86,7 @@ detect_leaks() {
 
 # Field $1 of libFuzzer's last "cov:" line ("#123<TAB>DONE   cov: 456 ft: 789 corp: 12/3Kb ...");
 # empty when the target stopped before libFuzzer printed one.
-stat_after() { { grep -E '^#[0-9]+[[:space:]].*cov: ' "$2" || true; } | tail -1 | sed -nE "s|.* $1: ([0-9]+).*|\1|p"; }
+stat_after() { { grep -E '^#[0-9]+:?[[:space:]].*cov: ' "$2" || true; } | tail -1 | sed -nE "s|.* $1:? ([0-9]+).*|\1|p"; }
 final_stat() { sed -nE "s/^stat::$1: *([0-9]+).*/\1/p" "$2" | tail -1; }
 
 # Inputs libFuzzer saved as crash, leak, timeout or out-of-memory (not its slow-unit-* notes).
@@ -103,13 +110,13 @@ for t in "${targets[@]}"; do
   echo "== $t: ${seconds} s$([ "$runs" = -1 ] || echo " or $runs executions")"
   set +e
   "$bin" -max_total_time="$seconds" -runs="$runs" -max_len="$(max_len "$t")" -detect_leaks="$(detect_leaks "$t")" \
-    -timeout=25 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/" "${corpora[@]}" >"$log" 2>&1
+    "${fork_args[@]}" -timeout=25 -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/" "${corpora[@]}" >"$log" 2>&1
   rc=$?
   set -e
   found=$(( $(crashes_in "$artifacts") - before ))
   execs=$(final_stat number_of_executed_units "$log")
   if [ -z "$execs" ]; then  # stopped by a crash: the last status line has the count
-    execs=$({ grep -E '^#[0-9]+[[:space:]]' "$log" || true; } | tail -1 | sed -nE 's/^#([0-9]+)[[:space:]].*/\1/p')
+    execs=$({ grep -E '^#[0-9]+:?[[:space:]]' "$log" || true; } | tail -1 | sed -nE 's/^#([0-9]+):?[[:space:]].*/\1/p')
   fi
   rate=$(final_stat average_exec_per_sec "$log")
   [ -n "$rate" ] || rate=$(stat_after exec/s "$log")
