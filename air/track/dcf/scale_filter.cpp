@@ -24,9 +24,9 @@ ScaleFilter::ScaleFilter(const ScaleFilterParams& p, cv::Size2d target) : p_(p),
 }
 
 cv::Mat ScaleFilter::features(const cv::Mat& frame, cv::Point2d pos, double scale) const {
-  const cv::Size2d unit = target_ * scale;  // the sample of factor 1, image pixels
-  cv::Mat region;                           // with resize_once: the largest sample's region at the model's resolution
+  cv::Mat region;  // with resize_once: the largest sample's region at the model's resolution
   if (p_.resize_once) {
+    const cv::Size2d unit = target_ * scale;  // the sample of factor 1, image pixels
     const cv::Size size(cvCeil(model_.width * factors_.front()) + 2, cvCeil(model_.height * factors_.front()) + 2);
     region = subwindow(frame, pos, {size.width * unit.width / model_.width, size.height * unit.height / model_.height},
                        size);

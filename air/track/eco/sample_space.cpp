@@ -7,25 +7,19 @@
 namespace aerie::track {
 
 // The spectra are of real signals (Hermitian: X[-k] = conj X[k]), so the columns right of the
-// middle repeat those left of it: the sums below count the left half twice, less the columns
-// that are their own mirror (0 and, for an even width, W / 2).
+// middle repeat those left of it: twice the left half, less the columns that are their own
+// mirror (0 and, for an even width, W / 2). The brute-force reference of the Gram matrix's
+// distances; inner() below sums the same columns.
 double SampleSpace::distance(const Sample& a, const Sample& b) {
-  double total = 0;
+  double d = 0;
   for (size_t c = 0; c < a.xf.size(); ++c) {
     const int w = a.xf[c].cols, half = w / 2 + 1;
-    for (int r = 0; r < a.xf[c].rows; ++r) {
-      const auto* pa = a.xf[c].ptr<cv::Vec2f>(r);
-      const auto* pb = b.xf[c].ptr<cv::Vec2f>(r);
-      auto term = [&](int k) {
-        const double re = double(pa[k][0]) - pb[k][0], im = double(pa[k][1]) - pb[k][1];
-        return re * re + im * im;
-      };
-      double row = 0;
-      for (int k = 0; k < half; ++k) row += term(k);
-      total += 2 * row - term(0) - (w % 2 == 0 && w > 1 ? term(w / 2) : 0.0);
-    }
+    auto cols = [&](int from, int to) {
+      return cv::norm(a.xf[c].colRange(from, to), b.xf[c].colRange(from, to), cv::NORM_L2SQR);
+    };
+    d += 2 * cols(0, half) - cols(0, 1) - (w % 2 == 0 && w > 1 ? cols(w / 2, w / 2 + 1) : 0.0);
   }
-  return total;
+  return d;
 }
 
 // sum_k a[k] b[k] over n floats, with OpenCV's universal intrinsics (a row of interleaved

@@ -26,7 +26,7 @@ class SampleSpace {
   const std::vector<Sample>& components() const { return components_; }
   const std::vector<double>& weights() const { return weights_; }
   // Squared Euclidean distance of two samples' feature spectra (summed over channels), which
-  // must be DFTs of real signals.
+  // must be DFTs of real signals: computed directly (the reference for distance(i, j)).
   static double distance(const Sample& a, const Sample& b);
   // Real part of the inner product of the two samples' full spectra (summed over channels).
   static double inner(const Sample& a, const Sample& b);
