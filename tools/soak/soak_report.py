@@ -3,7 +3,7 @@
 
 Reads what soak.sh and tools/soak/soak_monitor.py wrote in DIR (run.json, flights.csv,
 samples.csv, counters.csv, host.csv, events.csv, monitor.json, log-info.json) and writes
-DIR/soak.md, DIR/summary.json, DIR/rss.png and DIR/cpu.png.
+DIR/soak.md, DIR/summary.json, DIR/rss.png, DIR/cpu.png and DIR/heap.png.
 
 Per process: RSS after the warm-up (the median over the window that starts when the warm-up
 ends) and at the end (the median over the run's last window); the window is 60 s (two
@@ -12,8 +12,10 @@ also the slope of a least-squares line through every sample after the warm-up, a
 of the per-flight floor (the least RSS of each flight: the last three flights' median against
 the first three's after the warm-up). The warm-up
 is --warmup-minutes (default 3) or a third of the run, whichever is shorter. Processes
-restarted every flight (aerie-pilot, aerie-flightsim) are compared by the peak RSS of each
-run: the median of the first three runs after the warm-up against that of the last three. CPU: percent of one core, mean
+restarted every flight (aerie-pilot, aerie-flightsim) are compared by each run's median RSS:
+the median of the first three runs after the warm-up against that of the last three (a run's
+peak is its start-up, which the 1-s samples catch or miss by their phase; the peaks are
+reported beside). CPU: percent of one core, mean
 and 95th percentile of the 1-s samples after the warm-up.
 
 Exit status: 0 every flight landed within the success bounds and the logger lost nothing;
@@ -94,6 +96,11 @@ def floor_growth(s, flights, warm, t_end):
     return median(floors[-k:]) / median(floors[:k]) - 1
 
 
+def floor_cell(r):
+    """The per-flight floor's growth; for a process restarted each flight, that of its runs' peaks."""
+    return f"peaks {pct(r['peak_growth'])}" if "peak_growth" in r else pct(r.get("floor_growth", math.nan))
+
+
 def fmt(v, spec=".1f", none="–"):
     return none if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
@@ -151,18 +158,21 @@ def main():
                "threads_max": max(x[4] for x in s), "rss_peak_mb": max(x[2] for x in s) / 1024.0,
                "udp_drops": sum(udp[node].values()) if node in udp else None}
         if restarted:
-            peaks = {}
+            runs = defaultdict(list)
             first_t = {}
             for t, pid, rss, *_ in s:
-                peaks[pid] = max(peaks.get(pid, 0), rss)
+                runs[pid].append(rss)
                 first_t.setdefault(pid, t)
-            # The runs that started after the warm-up: the median peak of the first k against the
-            # median peak of the last k (a single run's peak depends on its seed).
-            later = [peaks[p] for p in pids if first_t[p] >= warm] or [peaks[p] for p in pids]
+            # The runs that started after the warm-up: the median of the first k runs' median RSS
+            # against the last k's; the same for their peaks (start-up transients, sampled or not).
+            later = [p for p in pids if first_t[p] >= warm] or pids
             k = max(1, min(3, len(later) // 3))
-            base, last = median(later[:k]), median(later[-k:])
+            level = [median(runs[p]) for p in later]
+            peak = [max(runs[p]) for p in later]
+            base, last = median(level[:k]), median(level[-k:])
             row.update(mode="restarted each flight", rss_base_mb=base / 1024.0, rss_end_mb=last / 1024.0,
-                       growth=last / base - 1 if base else math.nan, slope_mb_h=math.nan)
+                       growth=last / base - 1 if base else math.nan, slope_mb_h=math.nan,
+                       peak_growth=median(peak[-k:]) / median(peak[:k]) - 1)
         else:
             base = [x[2] for x in after if x[0] < warm + window]
             t_last = max(x[0] for x in s if x[0] <= t_end) if any(x[0] <= t_end for x in s) else t_end
@@ -238,6 +248,7 @@ def main():
 
     # --- Plots -----------------------------------------------------------------------------
     plotted = plots(d, series, nodes, warm, host)
+    heap_plotted = plotted and heap_plot(d, series, counters, warm)
 
     # --- soak.md -------------------------------------------------------------------------------
     L = []
@@ -289,14 +300,15 @@ def main():
     for r in rows:
         L.append(f"| {r['node']} | {r['program']} | {r['instances']} | {fmt(r['rss_base_mb'])} | {fmt(r['rss_end_mb'])} "
                  f"| {pct(r['growth'])} "
-                 f"| {fmt(r['slope_mb_h'], '+.2f')} | {pct(r.get('floor_growth', math.nan))} | {fmt(r['rss_peak_mb'])} | {fmt(r['cpu_mean'])} / {fmt(r['cpu_p95'])} "
+                 f"| {fmt(r['slope_mb_h'], '+.2f')} | {floor_cell(r)} | {fmt(r['rss_peak_mb'])} | {fmt(r['cpu_mean'])} / {fmt(r['cpu_p95'])} "
                  f"| {r['threads_max']} | {fmt(r['udp_drops'], 'd')} |")
     L.append("")
     L.append(f"Growth, for the processes that run the whole soak (runs = 1): the median RSS of the {window:.0f} s after "
              f"the warm-up ({warm / 60:.1f} min) against the median of the last {window:.0f} s; the slope is a least-squares "
              "line through every 1-s sample after the warm-up; the per-flight floor: the least RSS of each flight after the "
-             "warm-up, the median of the last three flights' against the first three's. Processes restarted each flight (runs > 1): the median "
-             "peak RSS of their first three runs after the warm-up against that of their last three. CPU: 1-s samples of /proc/PID/stat (utime + stime) "
+             "warm-up, the median of the last three flights' against the first three's. Processes restarted each flight (runs > 1): the "
+             "median RSS of each run, the first three runs' after the warm-up against the last three's (in the floor's column, "
+             "the same for each run's peak: its start-up, which the 1-s samples catch or miss). CPU: 1-s samples of /proc/PID/stat (utime + stime) "
              "after the warm-up, in % of one core. UDP datagrams dropped: by the kernel, for a full receive buffer of "
              "the process's sockets (/proc/net/udp; every LCM socket receives every channel of the multicast group).\n")
     if status_nodes:
@@ -349,6 +361,8 @@ def main():
         L.append("Failed: " + ", ".join(f"flight {f['flight']} (seed {f['seed']})" for f in failures) + ".\n")
     if plotted:
         L.append("![RSS](rss.png)\n\n![CPU](cpu.png)\n")
+    if heap_plotted:
+        L.append("![heap](heap.png)\n")
     with open(os.path.join(d, "soak.md"), "w") as f:
         f.write("\n".join(L))
     with open(os.path.join(d, "summary.json"), "w") as f:
@@ -413,6 +427,47 @@ def plots(d, series, nodes, warm, host):
         fig.tight_layout()
         fig.savefig(os.path.join(d, fname), dpi=90)
         plt.close(fig)
+    return True
+
+
+def heap_plot(d, series, counters, warm):
+    """heap.png: for each node whose status reports its heap (heap_in_use_kb, heap_free_kb: the
+    viewer, the map), its RSS, the heap in use, and in use + free (what malloc holds), as 60-s
+    medians: a leak raises the heap in use; fragmentation raises what malloc holds around it."""
+    import matplotlib.pyplot as plt
+    heap = defaultdict(lambda: defaultdict(dict))  # node -> time -> counter -> kB
+    for r in counters:
+        if r["counter"] in ("heap_in_use_kb", "heap_free_kb"):
+            heap[r["node"]][r["time_s"]][r["counter"]] = int(r["value"])
+    nodes = [n for n in heap if n in series]
+    if not nodes:
+        return False
+
+    def minute_medians(points):
+        by = defaultdict(list)
+        for t, v in points:
+            by[int(t // 60)].append(v)
+        return [k + 0.5 for k in sorted(by)], [median(by[k]) / 1024.0 for k in sorted(by)]
+
+    fig, axes = plt.subplots(1, len(nodes), figsize=(5.5 * len(nodes), 3.2), squeeze=False)
+    for ax, node in zip(axes[0], sorted(nodes)):
+        full = sorted((t, c) for t, c in heap[node].items() if len(c) == 2)
+        for label, pts in (("RSS", [(x[0], x[2]) for x in series[node]]),
+                           ("heap in use + free (held by malloc)", [(t, c["heap_in_use_kb"] + c["heap_free_kb"]) for t, c in full]),
+                           ("heap in use", [(t, c["heap_in_use_kb"]) for t, c in full])):
+            t, y = minute_medians(pts)
+            ax.plot(t, y, lw=1.0, marker=".", ms=3, label=label)
+        ax.axvline(warm / 60.0, color="grey", ls="--", lw=0.7)
+        ax.set_title(f"{node} ({PROGRAM.get(node, node)})", fontsize=9)
+        ax.set_xlabel("time (min)", fontsize=8)
+        ax.set_ylabel("MB (medians of 1 min)", fontsize=8)
+        ax.set_ylim(bottom=0)
+        ax.tick_params(labelsize=8)
+        ax.legend(fontsize=7)
+    fig.suptitle("Soak: heap of the nodes that report it (dashed: end of the warm-up)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "heap.png"), dpi=90)
+    plt.close(fig)
     return True
 
 
