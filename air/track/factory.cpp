@@ -207,6 +207,7 @@ std::unique_ptr<Tracker> make_eco(const util::Config& cfg) {
   in.read_in("update_interval", p.update_interval, 1, 1000);
   in.read("aberrance", p.aberrance);
   in.read_in("newton_iterations", p.newton_iterations, 0, 50);
+  in.read("colour_evidence", p.colour_evidence);
   in.read("lost_confidence", p.lost_confidence);
   in.read_in("lost_after", p.lost_after, 1, 1000);
   in.read("verify_threshold", p.verify_threshold);

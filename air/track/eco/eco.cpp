@@ -138,6 +138,15 @@ double EcoTracker::confidence_of(const Detection& d) const {
   return std::clamp(std::min(d.peak / mean_peak_, d.apce / mean_apce_), 0.0, 1.0);
 }
 
+double EcoTracker::colour_evidence(const Detection& d, cv::Point2d shift_cells) const {
+  const cv::Size2d t = target_in_model();
+  const cv::Point2d c(d.patch.cols / 2.0 + shift_cells.x * p_.cell, d.patch.rows / 2.0 + shift_cells.y * p_.cell);
+  const cv::Rect box = cv::Rect(cvRound(c.x - t.width / 2), cvRound(c.y - t.height / 2), std::max(1, cvRound(t.width)),
+                                std::max(1, cvRound(t.height))) &
+                       cv::Rect(0, 0, d.patch.cols, d.patch.rows);
+  return box.empty() ? 0.0 : cv::mean(colour_model_.likelihood(d.patch(box)))[0];
+}
+
 cv::Point2d EcoTracker::peak_offset(const Detection& d) const {
   const cv::Point2d grid(d.grid_peak);
   const cv::Point2d peak = newton_peak(d.rf, grid, p_.newton_iterations);
@@ -340,8 +349,11 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   TrackState s;
   s.pose = {pos_.x, pos_.y, scale_, 0.0};
   s.initial_size = target_;
-  s.confidence = confidence;
-  doubtful_frames_ = confidence < p_.lost_confidence ? doubtful_frames_ + 1 : 0;
+  // The filter's reliability and the colour model's evidence fail apart: a target turned or
+  // blurred lowers the first and keeps its colours, a box on background loses both
+  // (docs/results/track.md, "The LOST flag").
+  s.confidence = p_.colour_evidence && p_.hist_weight > 0 ? confidence * colour_evidence(d, shift) : confidence;
+  doubtful_frames_ = s.confidence < p_.lost_confidence ? doubtful_frames_ + 1 : 0;
   s.lost = doubtful_frames_ >= p_.lost_after;
   if (p_.verify_threshold > 0) {
     // The conservative verifier: does the box still look like the target? It learns only on

@@ -75,13 +75,16 @@ struct EcoParams {
   double scale_model_area = 1024;
   bool scale_resize_once = true;  // the samples from one resized region (ScaleFilterParams::resize_once)
   double min_scale = 0.2, max_scale = 5;
-  // Loss. Confidence = min(peak, APCE) relative to their running means; below
-  // update_confidence nothing is learned. The state says lost once the confidence has stayed
-  // below lost_confidence for lost_after frames in a row (the LOST flag, measured as a
-  // detector in docs/results/track.md), until it is above again.
+  // Loss. The filter's reliability = min(peak, APCE) relative to their running means; below
+  // update_confidence nothing is learned. The confidence the state reports is that reliability
+  // times, with colour_evidence (and the colour model on), the colour model's evidence that the
+  // box holds the target: the mean of P(foreground | colour) over the box. The state says lost
+  // once the confidence has stayed below lost_confidence for lost_after frames in a row (the
+  // LOST flag, measured as a detector in docs/results/track.md), until it is above again.
   double update_confidence = 0.3;
   double confidence_rate = 0.05;
-  double lost_confidence = 0.25;  // chosen on simulated exits (bench/track/lost_rule.py)
+  bool colour_evidence = true;
+  double lost_confidence = 0.08;  // chosen on simulated exits (bench/track/lost_rule.py)
   int lost_after = 2;
   // Appearance verifier (verifier.hpp; TLD's conservative model, Kalal et al. 2012): the state
   // also says lost once the similarity (largest normalised cross-correlation of the box's grey
@@ -138,6 +141,8 @@ class EcoTracker : public Tracker {
   std::vector<cv::Mat> spectra(const std::vector<cv::Mat>& maps) const;      // windowed DFTs
   Detection detect(const cv::Mat& frame, cv::Point2d centre) const;
   double confidence_of(const Detection& d) const;
+  // Mean P(foreground | colour) over the target's box in d's patch, moved by the sub-cell shift.
+  double colour_evidence(const Detection& d, cv::Point2d shift_cells) const;
   cv::Point2d peak_offset(const Detection& d) const;  // sub-cell peak as a shift in cells
   bool search_whole_image(const cv::Mat& frame, Detection& best, double& confidence) const;
   void add_sample(const Detection& d, cv::Point2d shift_cells);

@@ -249,14 +249,26 @@ TEST(Eco, TheTrainingFrameGivesTheSameBox) {
   const Scene scene({240, 180}, {40, 32});
   Motion m;
   m.centre = {100.3, 80.6};
-  EcoTracker t(EcoParams{});
+  EcoParams filter_only;
+  filter_only.colour_evidence = false;
+  EcoTracker t(filter_only);
   t.init(scene.render(m), scene.box(m));
   const TrackState s = t.update(scene.render(m));
   EXPECT_NEAR(s.pose.x, m.centre.x, 0.25);
   EXPECT_NEAR(s.pose.y, m.centre.y, 0.25);
   EXPECT_DOUBLE_EQ(s.pose.scale, 1.0);
-  EXPECT_NEAR(s.confidence, 1.0, 1e-9);
+  EXPECT_NEAR(s.confidence, 1.0, 1e-9);  // the filter's reliability: its peak and APCE are the running means
   EXPECT_FALSE(s.lost);
+  // With the colour evidence, the same box, times the mean P(foreground | colour) over it: the
+  // target's own colours, learned on this frame, more likely foreground than not.
+  EcoTracker c(EcoParams{});
+  c.init(scene.render(m), scene.box(m));
+  const TrackState sc = c.update(scene.render(m));
+  EXPECT_EQ(sc.pose.x, s.pose.x);
+  EXPECT_EQ(sc.pose.y, s.pose.y);
+  EXPECT_GT(sc.confidence, 0.5);
+  EXPECT_LT(sc.confidence, 1.0);
+  EXPECT_FALSE(sc.lost);
 }
 
 // The LOST flag rises within 5 frames of the target leaving the image, and stays down while it
