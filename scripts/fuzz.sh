@@ -84,10 +84,15 @@ detect_leaks() {
   esac
 }
 
-# Field $1 of libFuzzer's last "cov:" line ("#123<TAB>DONE   cov: 456 ft: 789 corp: 12/3Kb ...");
-# empty when the target stopped before libFuzzer printed one.
-stat_after() { { grep -E '^#[0-9]+:?[[:space:]].*cov: ' "$2" || true; } | tail -1 | sed -nE "s|.* $1:? ([0-9]+).*|\1|p"; }
-final_stat() { sed -nE "s/^stat::$1: *([0-9]+).*/\1/p" "$2" | tail -1; }
+# libFuzzer's status lines: "#123<TAB>DONE   cov: 456 ft: 789 corp: 12/3Kb ..."; in fork mode the
+# parent's are "#123: cov: ... exec/s 45 ... time: 67s" (sums over its jobs), and a job's own lines
+# and final stat:: lines can follow them in the log (a job interrupted with the parent prints
+# its own), so only the parent's count there.
+status_re='^#[0-9]+:?[[:space:]]'
+[ "$fork" -gt 0 ] && status_re='^#[0-9]+:[[:space:]]'
+# Field $1 of the last status line with "cov:"; empty when the target stopped before one.
+stat_after() { { grep -E "$status_re.*cov: " "$2" || true; } | tail -1 | sed -nE "s|.* $1:? ([0-9]+).*|\1|p"; }
+final_stat() { [ "$fork" -gt 0 ] || sed -nE "s/^stat::$1: *([0-9]+).*/\1/p" "$2" | tail -1; }
 
 # Inputs libFuzzer saved as crash, leak, timeout or out-of-memory (not its slow-unit-* notes).
 crashes_in() { find "$1" -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l; }
@@ -115,10 +120,14 @@ for t in "${targets[@]}"; do
   set -e
   found=$(( $(crashes_in "$artifacts") - before ))
   execs=$(final_stat number_of_executed_units "$log")
-  if [ -z "$execs" ]; then  # stopped by a crash: the last status line has the count
-    execs=$({ grep -E '^#[0-9]+:?[[:space:]]' "$log" || true; } | tail -1 | sed -nE 's/^#([0-9]+):?[[:space:]].*/\1/p')
+  if [ -z "$execs" ]; then  # fork mode, or stopped by a crash: the last status line has the count
+    execs=$({ grep -E "$status_re" "$log" || true; } | tail -1 | sed -nE 's/^#([0-9]+):?[[:space:]].*/\1/p')
   fi
   rate=$(final_stat average_exec_per_sec "$log")
+  if [ -z "$rate" ] && [ "$fork" -gt 0 ] && [ -n "$execs" ]; then  # the parent's: executions / its time
+    secs=$(stat_after time "$log")
+    [ -n "$secs" ] && [ "$secs" -gt 0 ] && rate=$(( execs / secs ))
+  fi
   [ -n "$rate" ] || rate=$(stat_after exec/s "$log")
   status=ok
   if [ "$found" -eq 0 ] && grep -q 'libFuzzer: run interrupted' "$log"; then
