@@ -49,7 +49,10 @@ function(aerie_test name)
   endif()
   if(A_XVFB)
     find_program(XVFB_RUN xvfb-run REQUIRED)
-    add_test(NAME ${name} COMMAND ${XVFB_RUN} -a $<TARGET_FILE:${name}>)
+    # -noreset: by default Xvfb resets when its last client disconnects, and a client that
+    # connects meanwhile (the next test's render window) gets no display ("bad X server
+    # connection"; 1 run of test_viewer in 6 on a loaded machine).
+    add_test(NAME ${name} COMMAND ${XVFB_RUN} -a -s "-screen 0 1280x1024x24 -noreset" $<TARGET_FILE:${name}>)
     # Two `xvfb-run -a` starting at once can both take display :99 and one's server then
     # goes with the other's (test_viewer lost its X server that way under ctest -j2): every
     # test that starts xvfb-run holds this lock.

@@ -40,7 +40,7 @@ aerie_start_xvfb() {
     local n=$((90 + RANDOM % 100))
     while [ -e "/tmp/.X$n-lock" ]; do n=$((n + 1)); done  # a display no X server holds
     export DISPLAY=:$n
-    Xvfb "$DISPLAY" -screen 0 1280x1024x24 -nolisten tcp >/dev/null 2>&1 &
+    Xvfb "$DISPLAY" -screen 0 1280x1024x24 -nolisten tcp -noreset >/dev/null 2>&1 &  # no reset when the last client leaves
     xvfb_pid=$!
   fi
 }
