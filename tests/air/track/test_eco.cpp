@@ -271,6 +271,25 @@ TEST(Eco, TheTrainingFrameGivesTheSameBox) {
   EXPECT_FALSE(sc.lost);
 }
 
+// The colour evidence by hand: a red square on blue, learned at init. On the training frame the
+// box holds red, P(fg | red) = 1 (red is in the foreground histogram only), so the confidence is
+// the filter's reliability (1) times about 1 (less the pixels the resize blends at the box's
+// edge); with the square gone, the box holds blue, P(fg | blue) = 0 exactly, so the confidence
+// is 0 whatever the filter says, and two such frames say lost.
+TEST(Eco, ColourEvidenceIsTheForegroundLikelihoodInTheBox) {
+  cv::Mat frame(180, 240, CV_8UC3, cv::Scalar(200, 40, 20));
+  const cv::Rect box(96, 64, 48, 40);
+  cv::rectangle(frame, box, cv::Scalar(30, 30, 220), cv::FILLED);
+  EcoTracker t(EcoParams{});
+  t.init(frame, box);
+  EXPECT_NEAR(t.update(frame).confidence, 1.0, 0.1);
+  const cv::Mat background(frame.size(), CV_8UC3, cv::Scalar(200, 40, 20));
+  const TrackState first = t.update(background);
+  EXPECT_EQ(first.confidence, 0.0);
+  EXPECT_FALSE(first.lost);  // lost_after 2
+  EXPECT_TRUE(t.update(background).lost);
+}
+
 // The LOST flag rises within 5 frames of the target leaving the image, and stays down while it
 // is tracked; when it comes back elsewhere, the whole-image search finds it again.
 TEST(Eco, LostWhileOutOfViewAndFoundAgain) {
