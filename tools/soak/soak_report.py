@@ -431,8 +431,8 @@ def plots(d, series, nodes, warm, host):
 
 
 def heap_plot(d, series, counters, warm):
-    """heap.png: for each node whose status reports its heap (heap_in_use_kb, heap_free_kb: the
-    viewer, the map), its RSS, the heap in use, and in use + free (what malloc holds), as 60-s
+    """heap.png: for each node whose status reports its heap (heap_in_use_kb, heap_free_kb: today
+    the viewer), its RSS, the heap in use, and in use + free (what malloc holds), as 60-s
     medians: a leak raises the heap in use; fragmentation raises what malloc holds around it."""
     import matplotlib.pyplot as plt
     heap = defaultdict(lambda: defaultdict(dict))  # node -> time -> counter -> kB
