@@ -7,6 +7,7 @@ set -euo pipefail
 usage() {
   cat <<'EOF'
 usage: scripts/fuzz.sh [--seconds N] [--runs R] [--fork F] [--target NAME]... [--jobs J] [--no-build]
+                       [--build-dir DIR]
 
   --seconds N    fuzzing time per target (default 600; with --runs, a ceiling)
   --runs R       stop each target after R executions (libFuzzer's -runs) or N seconds
@@ -15,6 +16,7 @@ usage: scripts/fuzz.sh [--seconds N] [--runs R] [--fork F] [--target NAME]... [-
   --target NAME  run only this target (repeatable; default: every fuzz/targets/*.cpp)
   --jobs J       parallel compile jobs (default: nproc; use 1 on a shared machine)
   --no-build     run the targets already built in build/fuzz
+  --build-dir D  the fuzz build folder instead of build/fuzz (below, build/fuzz stands for it)
   --help         this text
 
 Per target: new inputs go to build/fuzz/corpus/NAME/ (fuzz/corpus/NAME/ and
@@ -42,6 +44,7 @@ while [ $# -gt 0 ]; do
     --fork) fork=${2:?--fork needs a value}; shift 2 ;;
     --jobs) jobs=${2:?--jobs needs a value}; shift 2 ;;
     --no-build) do_build=0; shift ;;
+    --build-dir) build=${2:?--build-dir needs a folder}; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "fuzz.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
