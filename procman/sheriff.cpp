@@ -295,9 +295,8 @@ std::string Sheriff::table(int64_t now_ms) const {
   std::snprintf(line, sizeof line, "%-12s %-9s %7s %21s %10s\n", "DEPUTY", "STATE", "CPU", "MEM USED/TOTAL", "LAST SEEN");
   os << line;
   for (const auto& [host, dv] : deputies_) {
-    const double used = static_cast<double>(dv.info.phys_mem_total_bytes - dv.info.phys_mem_free_bytes) / 1048576.0;
     std::snprintf(line, sizeof line, "%-12s %-9s %6.1f%% %9.0f/%6.0f MiB %8.1f s\n", host.c_str(),
-                  deputy_alive(host, now_ms) ? "ok" : "LOST", 100.0 * dv.info.cpu_load, used,
+                  deputy_alive(host, now_ms) ? "ok" : "LOST", 100.0 * dv.info.cpu_load, dv.used_mib(),
                   static_cast<double>(dv.info.phys_mem_total_bytes) / 1048576.0,
                   static_cast<double>(now_ms - dv.last_seen_ms) / 1000.0);
     os << line;

@@ -58,6 +58,12 @@ struct DeputyView {
   int64_t reports = 0;
   bool synced = false;              // its commands were matched with ours
   bot_procman::info2_t info;
+
+  // Memory in use on the deputy's host (MiB), as its last report gives it; subtracted in double,
+  // since the figures come off the network (total INT64_MIN overflowed the int64 difference).
+  double used_mib() const {
+    return (static_cast<double>(info.phys_mem_total_bytes) - static_cast<double>(info.phys_mem_free_bytes)) / 1048576.0;
+  }
 };
 
 class Sheriff {

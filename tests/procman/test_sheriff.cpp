@@ -165,6 +165,23 @@ TEST(Sheriff, DerivesCommandStatesFromReports) {
   EXPECT_NE(table.find("testhost"), std::string::npos) << table;
 }
 
+// A report's memory figures come off the network: total = INT64_MIN (the fuzzer's find,
+// fuzz/regressions/procman_messages/info2_phys_mem_total_INT64_MIN.bin) overflowed the int64
+// difference the table took; it wrapped to about +8.8e12 MiB here. Now the difference is taken
+// in double, and the table shows the figure as the deputy sent it.
+TEST(Sheriff, HostileMemoryFiguresDoNotOverflowTheTable) {
+  Sheriff s("test-sheriff");
+  bot_procman::info2_t m = info("testhost", {});
+  m.phys_mem_total_bytes = std::numeric_limits<int64_t>::min();
+  m.phys_mem_free_bytes = 4866197946368;
+  s.on_info(m, 100);
+  const DeputyView& dv = s.deputies().at("testhost");
+  EXPECT_LT(dv.used_mib(), -8.7e12);
+  EXPECT_DOUBLE_EQ(dv.used_mib(), (-9223372036854775808.0 - 4866197946368.0) / 1048576.0);
+  const std::string table = s.table(100);
+  EXPECT_NE(table.find("-8796097662976/"), std::string::npos) << table;
+}
+
 TEST(Sheriff, CountsRespawnsFromPidChanges) {
   Sheriff s("sh");
   s.load(parse_pmd(kConfig));

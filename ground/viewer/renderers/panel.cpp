@@ -120,9 +120,8 @@ std::string ProcmanPanel::text() const {
   std::string s;
   char line[200];
   for (const auto& [host, dv] : observer_.deputies()) {
-    const double used = static_cast<double>(dv.info.phys_mem_total_bytes - dv.info.phys_mem_free_bytes) / 1048576.0;
     std::snprintf(line, sizeof line, "host %-8.8s %-4s cpu %5.1f%% mem %6.0f MiB\n", host.c_str(),
-                  observer_.deputy_alive(host, now) ? "ok" : "LOST", 100.0 * dv.info.cpu_load, used);
+                  observer_.deputy_alive(host, now) ? "ok" : "LOST", 100.0 * dv.info.cpu_load, dv.used_mib());
     s += line;
   }
   if (!observer_.commands().empty()) s += "  command          state       cpu    rss  rst\n";
