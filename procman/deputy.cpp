@@ -105,7 +105,8 @@ Deputy::OrdersResult Deputy::handle_orders(const bot_procman::orders2_t& orders,
   if (changed) *changed = false;
   if (exiting_) return OrdersResult::Exiting;
   if (orders.host != options_.name) return OrdersResult::OtherHost;
-  const double age_s = static_cast<double>(now_utime - orders.utime) * 1e-6;
+  // In double: the stamp comes off the network (INT64_MIN overflowed the int64 difference).
+  const double age_s = (static_cast<double>(now_utime) - static_cast<double>(orders.utime)) * 1e-6;
   const int64_t now = mono_ms();
   if (age_s > options_.max_order_age_s) {
     if (now - last_stale_warning_ms_ >= 5000) {  // at most every 5 s

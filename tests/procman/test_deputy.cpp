@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <thread>
 
 #include "procman/proc_stats.hpp"
@@ -241,6 +242,19 @@ TEST(Deputy, RefusesStaleOrdersAndTellsToCheckTheClocks) {
   EXPECT_EQ(h.deputy.handle_orders(aerie::procman::test::make_orders("other", {}), aerie::util::wall_utime()),
             Deputy::OrdersResult::OtherHost);
   EXPECT_NE(h.cmd(1), nullptr);
+}
+
+// The orders' stamp comes off the network: INT64_MIN (the fuzzer's find,
+// fuzz/regressions/procman_messages/orders2_utime_INT64_MIN.bin) overflowed the age's int64
+// difference. They are orders from the distant past: refused as stale, nothing started.
+TEST(Deputy, OrdersWithAHostileStampAreRefusedAsStale) {
+  DeputyHarness h;
+  CmdSpec c;
+  c.exec = "sleep 100";
+  auto orders = aerie::procman::test::make_orders(h.deputy.name(), {c});
+  orders.utime = std::numeric_limits<int64_t>::min();
+  EXPECT_EQ(h.deputy.handle_orders(orders, aerie::util::wall_utime()), Deputy::OrdersResult::Stale);
+  EXPECT_EQ(h.cmd(1), nullptr);
 }
 
 TEST(Deputy, NoOrphansSurviveAStop) {
