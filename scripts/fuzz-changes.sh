@@ -32,28 +32,27 @@ build=$root/build/fuzz
 ninja -C "$build" -t query "fuzz/fuzz_$target" >/dev/null 2>&1 ||
   { echo "fuzz-changes.sh: build/fuzz has no fuzz/fuzz_$target" >&2; exit 2; }
 
-tmp=$(mktemp)
-trap 'rm -f "$tmp"' EXIT
 inputs=$(ninja -C "$build" -t inputs "fuzz/fuzz_$target")
 closure=$(
   cd "$build"
   {
     grep -E '\.(c|cc|cpp|h|hpp)$' <<<"$inputs" || true
     for o in $(grep '\.o$' <<<"$inputs"); do ninja -t deps "$o" | sed -n 's/^    //p'; done
-  } | while read -r f; do realpath -m "$f"; done | sort -u
+  } | xargs -r realpath -m | sort -u
 )
-{
-  # repository files, and each generated message header as its .lcm
-  sed -n "s#^$root/##p" <<<"$closure" | grep -v '^build/' || true
-  sed -nE "s#^$build/lcmtypes/include/aerie/(.*)\.hpp\$#lcmtypes/aerie_\1.lcm#p" <<<"$closure"
-  # configs the target loads at run time
-  grep -oE '"config/[A-Za-z0-9_./-]+\.yaml"' "$root/fuzz/targets/$target.cpp" | tr -d '"' || true
-} | sort -u >"$tmp"
+mapfile -t files < <(
+  {
+    # repository files, and each generated message header as its .lcm
+    sed -n "s#^$root/##p" <<<"$closure" | grep -v '^build/' || true
+    sed -nE "s#^$build/lcmtypes/include/aerie/(.*)\.hpp\$#lcmtypes/aerie_\1.lcm#p" <<<"$closure"
+    # configs the target loads at run time
+    grep -oE '"config/[A-Za-z0-9_./-]+\.yaml"' "$root/fuzz/targets/$target.cpp" | tr -d '"' || true
+  } | sort -u
+)
 
-if [ $files_only = 1 ]; then cat "$tmp"; exit 0; fi
+if [ $files_only = 1 ]; then printf '%s\n' "${files[@]}"; exit 0; fi
 cd "$root"
 if git rev-parse -q --verify "$since^{commit}" >/dev/null; then range=("$since..HEAD"); else range=(--since="$since" HEAD); fi
-mapfile -t files <"$tmp"
 TZ=UTC git log --reverse --format='%h %ad' --date=format-local:'%Y-%m-%d %H:%M' "${range[@]}" -- "${files[@]}" |
   while read -r hash day hour; do
     echo "$hash $day $hour UTC: $(git show --name-only --format= "$hash" -- "${files[@]}" | tr '\n' ' ')"

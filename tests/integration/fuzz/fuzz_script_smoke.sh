@@ -18,50 +18,48 @@ check() {  # DESCRIPTION COMMAND...
   shift
   if "$@"; then echo "ok   $what"; else echo "FAIL $what"; fail=1; fi
 }
-fuzz() {  # LOG RC ARTIFACT FUZZ.SH-ARGS...: runs fuzz.sh, its status in $rc, its output in $out
-  local log=$1 code=$2 artifact=$3
-  shift 3
+fuzz() {  # EXPECTED-STATUS LOG RC ARTIFACT FUZZ.SH-ARGS...: runs fuzz.sh, checks its exit
+  local expected=$1 log=$2 code=$3 artifact=$4        # status; its output is left in $out
+  shift 4
   out=$(FAKE_LOG="$here/logs/$log" FAKE_RC=$code FAKE_ARTIFACT=$artifact \
         bash "$src/scripts/fuzz.sh" --no-build --build-dir "$work" "$@" 2>&1)
-  rc=$?
+  local rc=$?
   echo "$out" | sed 's/^/    /'
+  check "exit $expected" test "$rc" -eq "$expected"
 }
 row() { grep "^| $1 |" "$work/results.md"; }
-passed() { grep -qx -- "$1" "$FAKE_ARGS"; }
+passed() { local a; for a in "$@"; do grep -qx -- "$a" "$FAKE_ARGS" || return 1; done; }
+says() { [[ "$out" == *"$1"* ]]; }
 
 echo "-- a run to its end (-runs reached)"
-fuzz done.log 0 "" --runs 1000 --seconds 5 --target config
-check "exit 0" test "$rc" -eq 0
+fuzz 0 done.log 0 "" --runs 1000 --seconds 5 --target config
 check "row: the final stat:: count and rate, cov/ft/corpus of the last status line" \
   test "$(row config)" = "| config | 1000000 | 3278 | 1741 | 2783 | 213 | 0 | ok |"
 check "passes -runs, -max_total_time, leak checks for a non-node target" \
-  eval 'passed -runs=1000 && passed -max_total_time=5 && passed -detect_leaks=1 && passed -max_len=65536'
-check "reads the corpus it grows, then the seeds" \
-  eval 'passed "$work/corpus/config" && passed "$src/fuzz/corpus/config"'
+  passed -runs=1000 -max_total_time=5 -detect_leaks=1 -max_len=65536
+check "reads the corpus it grows, then the seeds" passed "$work/corpus/config" "$src/fuzz/corpus/config"
 
 echo "-- fork mode, interrupted: the parent's count, not the job's stat:: lines after it"
-fuzz fork_interrupted.log 72 "" --fork 2 --seconds 5 --target node_track
-check "exit 0" test "$rc" -eq 0
+fuzz 0 fork_interrupted.log 72 "" --fork 2 --seconds 5 --target node_track
 check "row: 1,077,884 executions, cov 20431, ft 17947, corpus 1141, interrupted" \
   test "$(row node_track)" = "| node_track | 1077884 | 202 | 20431 | 17947 | 1141 | 0 | interrupted (SIGINT), no crash |"
 check "passes -fork=2 and -ignore_crashes=0, no leak checks for a node target" \
-  eval 'passed -fork=2 && passed -ignore_crashes=0 && passed -detect_leaks=0'
+  passed -fork=2 -ignore_crashes=0 -detect_leaks=0
 
 echo "-- a crash"
-fuzz crash.log 1 crash-5f3a9c --seconds 5 --target config
-check "exit 1" test "$rc" -eq 1
+fuzz 1 crash.log 1 crash-5f3a9c --seconds 5 --target config
 check "row: the sanitizer's first line and the input" \
   eval '[[ "$(row config)" == "| config | 1530 | "*" | 2402 | 7104 | 374 | 1 | CRASH: ERROR: AddressSanitizer: heap-buffer-overflow"*"(crash-5f3a9c) |" ]]'
-check "names the target on stderr" eval '[[ "$out" == *"crashes in: config"* ]]'
+check "names the target on stderr" says "crashes in: config"
 
 echo "-- bad arguments"
-fuzz done.log 0 "" --fork two --target config
-check "--fork two refused" eval '[ "$rc" -eq 2 ] && [[ "$out" == *"--fork must be a number"* ]]'
-fuzz done.log 0 "" --target no_such_target
-check "an unknown target refused" eval '[ "$rc" -eq 2 ] && [[ "$out" == *"no target '"'"'no_such_target'"'"'"* ]]'
-fuzz done.log 0 "" --target node_vo
-check "a target not built refused" eval '[ "$rc" -eq 2 ] && [[ "$out" == *"fuzz_node_vo is not built"* ]]'
-fuzz done.log 0 "" --seconds 0 --target config
-check "--seconds 0 refused" eval '[ "$rc" -eq 2 ] && [[ "$out" == *"--seconds must be a positive integer"* ]]'
+fuzz 2 done.log 0 "" --fork two --target config
+check "--fork two refused" says "--fork must be a number"
+fuzz 2 done.log 0 "" --target no_such_target
+check "an unknown target refused" says "no target 'no_such_target'"
+fuzz 2 done.log 0 "" --target node_vo
+check "a target not built refused" says "fuzz_node_vo is not built"
+fuzz 2 done.log 0 "" --seconds 0 --target config
+check "--seconds 0 refused" says "--seconds must be a positive integer"
 
 exit $fail
