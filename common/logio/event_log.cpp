@@ -21,6 +21,9 @@ void put_u64(uint8_t* p, uint64_t v) {
   put_u32(p, static_cast<uint32_t>(v >> 32));
   put_u32(p + 4, static_cast<uint32_t>(v));
 }
+// LCM's event counter is a u64 on disk: the number after INT64_MAX (read as int64) wraps to
+// INT64_MIN rather than overflowing.
+int64_t next_event_number(int64_t n) { return static_cast<int64_t>(static_cast<uint64_t>(n) + 1); }
 std::string hex32(uint32_t v) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "0x%08X", v);
@@ -143,7 +146,7 @@ bool Reader::next(Event& ev) {
       if (!in_) throw std::runtime_error(path_ + ": read error at byte " + std::to_string(offset_));
       ev.offset = offset_;
       offset_ += kHeaderSize + cl + dl;
-      expected_event_ = ev.event_number + 1;
+      expected_event_ = next_event_number(ev.event_number);
       return true;
     }
     const auto kind = check == HeaderCheck::Truncated ? Damage::Kind::Truncated
@@ -183,7 +186,7 @@ void Writer::write(int64_t utime, const std::string& channel, const void* data, 
   out_.write(channel.data(), static_cast<std::streamsize>(channel.size()));
   out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
   if (!out_) throw std::runtime_error(path_ + ": write failed (disk full?)");
-  ++next_number_;
+  next_number_ = next_event_number(next_number_);
 }
 
 void Writer::write(const Event& ev, bool keep_numbers) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "common/logio/event_log.hpp"
 #include "tests/support/test_support.hpp"
@@ -62,6 +63,38 @@ TEST(EventLog, RoundTripIsIdentical) {
   for (const auto& ev : r.events) w.write(ev, true);
   w.close();
   EXPECT_EQ(slurp(dir / "a.lcm"), slurp(dir / "b.lcm"));
+}
+
+// The event counter is a u64 on disk: numbers written as kept go on past INT64_MAX by wrapping
+// (found by fuzz_event_log: the reader's expected next number overflowed), and a damage report
+// after such an event names the wrapped number.
+TEST(EventLog, EventNumbersWrapPastInt64Max) {
+  const auto dir = test::scratch_dir("log");
+  const int64_t max = std::numeric_limits<int64_t>::max();
+  {
+    Writer w((dir / "w.lcm").string());
+    Event ev;
+    ev.event_number = max - 1;
+    ev.utime = 1;
+    ev.channel = "GT_POSE";
+    ev.data = payload(1);
+    w.write(ev, true);
+    w.write(2, "GT_POSE", ev.data.data(), ev.data.size());  // max
+    w.write(3, "GT_POSE", ev.data.data(), ev.data.size());  // wraps
+  }
+  auto bytes = slurp(dir / "w.lcm");
+  const auto r = read_all((dir / "w.lcm").string());
+  EXPECT_TRUE(r.damage.empty());
+  ASSERT_EQ(r.events.size(), 3u);
+  EXPECT_EQ(r.events[1].event_number, max);
+  EXPECT_EQ(r.events[2].event_number, std::numeric_limits<int64_t>::min());
+  // Cut inside the third event: the damage names the number expected after INT64_MAX.
+  bytes.resize(bytes.size() - 2);
+  dump(dir / "t.lcm", bytes);
+  const auto t = read_all((dir / "t.lcm").string());
+  ASSERT_EQ(t.events.size(), 2u);
+  ASSERT_EQ(t.damage.size(), 1u);
+  EXPECT_EQ(t.damage[0].event_number, std::numeric_limits<int64_t>::min());
 }
 
 TEST(EventLog, HeaderIsBigEndianLcmLayout) {
