@@ -72,8 +72,10 @@ grep -q "100% tests passed" "$build/sanitize-ctest.log" || status=1
 done_at=$(date +%s)
 
 # Reports in the output of tests that passed all the same (e.g. from a node whose exit status
-# the test does not check).
-marks='runtime error:|ERROR: AddressSanitizer|ERROR: LeakSanitizer|WARNING: ThreadSanitizer'
+# the test does not check). Anchored at the start of a line as the runtimes print them
+# ("==PID==ERROR: AddressSanitizer", "file:line:col: runtime error:"): fuzz_script_smoke prints
+# fuzz.sh's summary of a fake crash ("...: CRASH: ERROR: AddressSanitizer: ..."), which is no report.
+marks='^[^ ]+:[0-9]+:[0-9]+: runtime error:|^==[0-9]+==(ERROR: (AddressSanitizer|LeakSanitizer)|WARNING: ThreadSanitizer)'
 in_log=$(grep -cE "$marks" "$build/Testing/Temporary/LastTest.log" 2>/dev/null || true)
 if [ "${in_log:-0}" -gt 0 ]; then
   status=1

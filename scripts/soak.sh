@@ -84,6 +84,12 @@ done
 # --- A private network namespace (--netns): run this script again inside one ---------
 if [ "$netns" = 1 ] && [ -z "${AERIE_SOAK_NETNS:-}" ]; then
   [ "$(id -u)" -eq 0 ] || { echo "soak: --netns needs root (ip netns add)" >&2; exit 2; }
+  # A namespace left by a run that was killed (SIGKILL, e.g. a test's timeout, runs no trap):
+  # its shell is gone and nothing runs in it any more.
+  for old in $(ip netns list | awk '/^aerie-soak-[0-9]+( |$)/ {print $1}'); do
+    kill -0 "${old#aerie-soak-}" 2>/dev/null || [ -n "$(ip netns pids "$old" 2>/dev/null)" ] ||
+      { ip netns del "$old" && echo "soak: removed $old, left by a run that was killed"; }
+  done
   ns="aerie-soak-$$"
   ip netns add "$ns"
   trap 'ip netns del "$ns" 2>/dev/null || true' EXIT
@@ -251,8 +257,10 @@ while [ "$interrupted" = 0 ]; do
   fi
   start=$(elapsed)
   status=0
+  # flightsim ends the flight itself (landed, or 120 s of simulated flight); the sheriff's
+  # wait is only a backstop for a hung one, long enough for a sanitizer build's slower sim.
   "$BIN/aerie-sheriff" "$out/pmd/flight-$tag.pmd" --script soak_flight --on-script-complete exit --no-table \
-    --wait-timeout 300 >"$out/sheriff/flight-$tag.log" 2>&1 || status=$?
+    --wait-timeout 900 >"$out/sheriff/flight-$tag.log" 2>&1 || status=$?
   end=$(elapsed)
   kill_row=",,,"
   if [ -n "$killer_pid" ]; then

@@ -267,8 +267,8 @@ def main():
     L.append(f"* Landings: **{success}/{len(done)}** within the success bounds ({landed} landed)"
              + (f", touchdown error {sum(errs) / len(errs) * 100:.1f} cm mean / {percentile(errs, 95) * 100:.1f} cm p95"
                 if errs else "")
-             + (f", flight {sum(ftimes) / len(ftimes):.1f} s mean (simulated), {sum(cycle) / len(cycle):.1f} s per cycle with "
-                "the restarts" if cycle else "")
+             + (f", flight {sum(ftimes) / len(ftimes):.1f} s mean (simulated)" if ftimes else "")
+             + (f", {sum(cycle) / len(cycle):.1f} s per cycle with the restarts" if cycle else "")
              + f"; the pilot held (HOLD) {summary['holds']} times in {sum(1 for f in done if f['holds'])} flights, "
                f"{sum(f['holds_stale'] for f in done)} of them for a stale tracker (no TRACK for 0.5 s).")
     if log:
