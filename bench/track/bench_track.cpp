@@ -11,10 +11,13 @@
 // LOST flag scored like a detector), <out>/attributes.csv and <out>/sequence_attributes.csv
 // (per OTB attribute). With --folds K [--grid FILE] the settings of each tracker are chosen by
 // k-fold cross-validation over the sequences: <out>/folds.csv, <out>/heldout_summary.csv and
-// <out>/candidates.csv (docs/track.md).
+// <out>/candidates.csv (docs/track.md). With --starts K every sequence is also tracked from K - 1
+// later frames (OTB's temporal robustness evaluation): each segment is a row of its own, and the
+// segments of a sequence share its fold.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <cstdlib>
@@ -304,8 +307,12 @@ void write_folds(const fs::path& out, const Setup& setup, const std::vector<eval
   std::ofstream sum(out / "heldout_summary.csv");
   sum << "tracker,sequences,tuned_auc,tuned_p20,tuned_cle,heldout_auc,heldout_p20,heldout_cle\n";
   const int k = *std::max_element(fold.begin(), fold.end()) + 1;
+  std::vector<std::string> bases;
+  for (const auto& seq : sequences) bases.push_back(eval::base_name(seq.name));
+  std::sort(bases.begin(), bases.end());
+  const bool loo = k == std::unique(bases.begin(), bases.end()) - bases.begin();
   spdlog::info("{}-fold cross-validation ({}): settings chosen on the other folds, scored on the fold held out", k,
-               k == static_cast<int>(fold.size()) ? "leave one sequence out" : "sequence i in fold i mod k");
+               loo ? "leave one sequence out" : "sequence i in fold i mod k");
   spdlog::info("{:>18} {:>4} {:>9}  {:>27}  {:>27}", "tracker", "fold", "candidate", "tuned-on  AUC   P20    CLE",
                "held-out  AUC   P20    CLE");
   for (size_t t = 0; t < setup.trackers.size(); ++t) {
@@ -339,7 +346,7 @@ int main(int argc, char** argv) {
   CLI::App app{"OTB one-pass evaluation of Aerie's trackers and OpenCV's reference trackers"};
   std::string data, out = "track-bench", trackers_arg, sequences_arg, config_path, resize_arg, grid_path;
   uint64_t seed = 1;
-  int max_frames = 0, repeats = 1, folds = 0;
+  int max_frames = 0, repeats = 1, folds = 0, starts = 1;
   bool no_plots = false, states = false;
   std::string log_level = "info";
   app.add_option("--data", data, "folder of sequences: <SEQ>/img/* and <SEQ>/groundtruth.txt")->required();
@@ -356,6 +363,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--resize", resize_arg, "resize frames and boxes to WxH (e.g. 640x480) before tracking");
   app.add_option("--max-frames", max_frames, "use at most this many frames per sequence (0 = all)");
+  app.add_option("--starts", starts,
+                 "OTB's temporal robustness evaluation: also track every sequence from frames floor(j n / K), "
+                 "j = 1 .. K-1 (the next frame with a visible target), each to the end, as the segment <SEQ>@<frame>; "
+                 "1 = one pass from frame 1. A sequence's segments share its fold")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   app.add_flag("--no-plots", no_plots, "skip the PNG plots");
   app.add_flag("--states", states, "also write <out>/<tracker>/<SEQ>.states.csv (confidence, lost, IoU per frame)");
   auto* folds_opt = app.add_option(
@@ -409,6 +422,14 @@ int main(int argc, char** argv) {
       sequences = keep;
     }
     if (sequences.empty()) throw std::runtime_error(data + ": no sequences (<SEQ>/img + groundtruth.txt)");
+    if (starts > 1) {
+      std::vector<eval::Sequence> segments;
+      for (const auto& seq : sequences)
+        for (auto& seg : eval::temporal_segments(seq, starts)) segments.push_back(std::move(seg));
+      spdlog::info("temporal robustness: {} segments of {} sequences ({} starts each)", segments.size(),
+                   sequences.size(), starts);
+      sequences = std::move(segments);
+    }
     // Every check before any tracking: the fold count and every candidate of the grid.
     std::vector<int> fold;
     if (folds != 0) {

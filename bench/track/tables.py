@@ -6,10 +6,11 @@ usage: tables.py NATIVE_OUT [RESIZED_OUT]
   RESIZED_OUT: the same trackers with --resize 640x480 (speed and accuracy side by side)
 
 The last table compares each tracker with OpenCV's CSRT sequence by sequence on the held-out
-AUC (each sequence scored with the candidate its fold chose on the other folds): the mean
-difference, the sequences won, and a 95 % paired bootstrap interval of the mean difference
-(10,000 resamples of the sequences, seed 1): how far the mean over this many sequences can be
-trusted to carry over to other footage of the same kind.
+AUC (each sequence scored with the candidate its fold chose on the other folds; with --starts,
+the mean over the sequence's segments): the mean difference, the sequences won, and a 95 %
+paired bootstrap interval of the mean difference (10,000 resamples of the sequences, seed 1):
+how far the mean over this many sequences can be trusted to carry over to other footage of the
+same kind.
 """
 import csv
 import os
@@ -30,13 +31,14 @@ def f3(v):
 
 
 def heldout_per_sequence(native):
-    """tracker -> sequence -> held-out AUC: the candidate chosen for the sequence's fold."""
+    """tracker -> sequence -> held-out AUC: the candidate chosen for the sequence's fold, averaged
+    over the sequence's segments (SEQ, SEQ@frame, ... with --starts)."""
     chosen = {(r["tracker"], r["fold"]): r["candidate"] for r in rows(os.path.join(native, "folds.csv"))}
-    out = {}
+    segments = {}
     for r in rows(os.path.join(native, "candidates.csv")):
         if chosen.get((r["tracker"], r["fold"])) == r["candidate"]:
-            out.setdefault(r["tracker"], {})[r["sequence"]] = float(r["success_auc"])
-    return out
+            segments.setdefault(r["tracker"], {}).setdefault(r["sequence"].split("@")[0], []).append(float(r["success_auc"]))
+    return {t: {q: float(np.mean(v)) for q, v in per.items()} for t, per in segments.items()}
 
 
 def paired_bootstrap(diff, resamples=10000, seed=1):

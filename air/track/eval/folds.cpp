@@ -1,8 +1,9 @@
 #include "air/track/eval/folds.hpp"
 
 #include <algorithm>
-#include <numeric>
 #include <stdexcept>
+
+#include "air/track/eval/sequence.hpp"
 
 namespace aerie::track::eval {
 namespace {
@@ -16,15 +17,18 @@ Figures mean_over(const std::vector<Figures>& per_sequence, const std::vector<si
 }  // namespace
 
 std::vector<int> assign_folds(const std::vector<std::string>& sequences, int k) {
-  const int n = static_cast<int>(sequences.size());
+  std::vector<std::string> bases;
+  for (const auto& s : sequences) bases.push_back(base_name(s));
+  std::vector<std::string> distinct = bases;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  const int n = static_cast<int>(distinct.size());
   if (k < 2 || k > n)
     throw std::invalid_argument(std::to_string(k) + " folds for " + std::to_string(n) +
                                 " sequences (need 2 <= folds <= sequences; folds = sequences is leave-one-out)");
-  std::vector<size_t> order(sequences.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return sequences[a] < sequences[b]; });
   std::vector<int> fold(sequences.size());
-  for (size_t rank = 0; rank < order.size(); ++rank) fold[order[rank]] = static_cast<int>(rank) % k;
+  for (size_t i = 0; i < bases.size(); ++i)
+    fold[i] = static_cast<int>(std::lower_bound(distinct.begin(), distinct.end(), bases[i]) - distinct.begin()) % k;
   return fold;
 }
 

@@ -9,9 +9,10 @@
 
 namespace aerie::track::eval {
 
-// The fold of sequences[i]: its rank among the names sorted (byte order) modulo k, so
-// k = sequences.size() is leave-one-sequence-out. Throws std::invalid_argument unless
-// 2 <= k <= sequences.size().
+// The fold of sequences[i]: the rank of its base_name() among the distinct base names sorted
+// (byte order) modulo k, so that the segments of one sequence (temporal_segments) share its
+// fold, and k = the number of sequences is leave-one-sequence-out. Throws
+// std::invalid_argument unless 2 <= k <= that number.
 std::vector<int> assign_folds(const std::vector<std::string>& sequences, int k);
 
 struct FoldResult {

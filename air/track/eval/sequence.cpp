@@ -83,4 +83,24 @@ std::vector<Sequence> find_sequences(const fs::path& data_dir) {
   return out;
 }
 
+std::vector<Sequence> temporal_segments(const Sequence& s, int k) {
+  if (k < 1) throw std::invalid_argument("temporal segments: k = " + std::to_string(k) + ", need k >= 1");
+  const size_t n = s.frames.size();
+  std::vector<Sequence> out{s};
+  size_t last = 0;
+  for (int j = 1; j < k; ++j) {
+    size_t start = j * n / k;
+    while (start < n && !is_valid_box(s.groundtruth[start])) ++start;
+    if (start <= last || start + 2 > n) continue;
+    last = start;
+    Sequence seg{s.name + "@" + std::to_string(start + 1), s.dir,
+                 {s.frames.begin() + static_cast<std::ptrdiff_t>(start), s.frames.end()},
+                 {s.groundtruth.begin() + static_cast<std::ptrdiff_t>(start), s.groundtruth.end()}};
+    out.push_back(std::move(seg));
+  }
+  return out;
+}
+
+std::string base_name(const std::string& segment) { return segment.substr(0, segment.find('@')); }
+
 }  // namespace aerie::track::eval

@@ -27,4 +27,14 @@ void write_boxes(const std::filesystem::path& file, const std::vector<cv::Rect2d
 
 bool is_valid_box(const cv::Rect2d& b);
 
+// OTB's temporal robustness evaluation (TRE; Wu et al., CVPR 2013, sec. 4.1): the sequence and
+// k - 1 segments of it, segment j starting at frame floor(j n / k) (moved on to the next frame
+// whose target is visible) and running to the end. Segment j > 0 is named
+// "<name>@<its first frame, 1-based>"; segment 0 is the sequence itself. A start that repeats
+// the one before, or leaves fewer than 2 frames, gives no segment. Throws std::invalid_argument
+// unless k >= 1.
+std::vector<Sequence> temporal_segments(const Sequence& s, int k);
+// The sequence a segment belongs to: its name up to the first '@'.
+std::string base_name(const std::string& segment);
+
 }  // namespace aerie::track::eval

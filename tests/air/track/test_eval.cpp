@@ -71,6 +71,35 @@ TEST(Sequence, FindsOtbFoldersAndChecksCounts) {
   EXPECT_EQ(seqs[0].frames.back().filename(), "0003.jpg");
 }
 
+// TRE segments by hand: 10 frames, k = 3 -> starts floor(10 j / 3) = 3, 6 (0-based); frame 3 has no
+// visible target, so that segment starts at frame 4 ("@5", 1-based). k larger than the frames
+// gives each start once and never a segment of fewer than 2 frames.
+TEST(Sequence, TemporalSegmentsByHand) {
+  Sequence s{"S", "dir", {}, {}};
+  for (int i = 0; i < 10; ++i) {
+    s.frames.push_back("f" + std::to_string(i) + ".jpg");
+    s.groundtruth.push_back(i == 3 ? cv::Rect2d(0, 0, NAN, NAN) : cv::Rect2d(i, 0, 5, 5));
+  }
+  const auto seg = temporal_segments(s, 3);
+  ASSERT_EQ(seg.size(), 3u);
+  EXPECT_EQ(seg[0].name, "S");
+  EXPECT_EQ(seg[0].frames.size(), 10u);
+  EXPECT_EQ(seg[1].name, "S@5");
+  EXPECT_EQ(seg[1].frames.size(), 6u);
+  EXPECT_EQ(seg[1].frames.front(), "f4.jpg");
+  EXPECT_EQ(seg[1].groundtruth.front().x, 4);
+  EXPECT_EQ(seg[2].name, "S@7");
+  EXPECT_EQ(seg[2].groundtruth.size(), 4u);
+  EXPECT_EQ(temporal_segments(s, 1).size(), 1u);
+  const auto many = temporal_segments(s, 40);  // the sequence, then 1, 2, 4 (3 moved on), 5, 6, 7, 8; 9 leaves 1 frame
+  ASSERT_EQ(many.size(), 8u);
+  EXPECT_EQ(many.back().name, "S@9");
+  EXPECT_EQ(many.back().frames.size(), 2u);
+  EXPECT_EQ(base_name("S@9"), "S");
+  EXPECT_EQ(base_name("S"), "S");
+  EXPECT_THROW(temporal_segments(s, 0), std::invalid_argument);
+}
+
 TEST(Sequence, SharedGirlSequence) {
   AERIE_REQUIRE_DATA("tracking/Girl");
   const Sequence s = load_sequence(aerie::test::shared_data("tracking/Girl"));
@@ -219,6 +248,14 @@ TEST(Folds, AssignmentBySortedNameModuloK) {
   aerie::test::expect_refusals([&](const std::string& k) { assign_folds(names, std::stoi(k)); },
                                {{"1", "1 folds for 5 sequences"}, {"6", "need 2 <= folds <= sequences"},
                                 {"0", "need 2 <= folds"}});
+}
+
+// A sequence's TRE segments share its fold; the count of folds is bounded by the sequences, not the segments.
+TEST(Folds, SegmentsShareTheirSequencesFold) {
+  const std::vector<std::string> names = {"b", "b@40", "a", "a@20", "c@7", "c", "a@60"};  // sequences: a b c
+  EXPECT_EQ(assign_folds(names, 2), (std::vector<int>{1, 1, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(assign_folds(names, 3), (std::vector<int>{1, 1, 0, 0, 2, 2, 0}));
+  EXPECT_THROW(assign_folds(names, 4), std::invalid_argument);  // 3 sequences
 }
 
 TEST(Folds, TunedOnAndHeldOutByHand) {
