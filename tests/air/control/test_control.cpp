@@ -624,7 +624,9 @@ TEST(ControlNode, TheManoeuvreIsRefusedWhenItsFrameIsLost) {
     drain(bus);
     ASSERT_EQ(cmds.size(), restarted_nav ? 24u : 19u) << restarted_nav;
     EXPECT_EQ(cmds.front().mode, restarted_nav ? aerie::control_cmd_t::ACTIVE : aerie::control_cmd_t::FALLBACK_HOVER);
-    if (restarted_nav) EXPECT_EQ(cmds[11].mode, aerie::control_cmd_t::ACTIVE);  // after the lone INITIALISING
+    if (restarted_nav) {  // after the lone INITIALISING
+      EXPECT_EQ(cmds[11].mode, aerie::control_cmd_t::ACTIVE);
+    }
     EXPECT_EQ(cmds.back().mode, aerie::control_cmd_t::FALLBACK_HOVER) << restarted_nav;  // for good
     EXPECT_EQ(cmds.back().velocity_body[0], 0.0f);
     EXPECT_EQ(cmds.back().yaw_rate_deg_s, 0.0f);

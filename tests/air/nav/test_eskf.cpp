@@ -501,7 +501,9 @@ TEST(Eskf, ResumesFromASnapshotInTheSameFrame) {
   for (int k = 1; k <= 1000; ++k) {  // 5 s
     const double t = k * 0.005;
     ASSERT_TRUE(before.add_imu(exact_imu(t, utime_of(t))).accepted);
-    if (k % 10 == 0) ASSERT_TRUE(before.add_vo(vo_at(t)).accepted);
+    if (k % 10 == 0) {
+      ASSERT_TRUE(before.add_vo(vo_at(t)).accepted);
+    }
   }
   ASSERT_TRUE(before.T_world_vo());
   const Snapshot snap = before.snapshot();
@@ -526,7 +528,9 @@ TEST(Eskf, ResumesFromASnapshotInTheSameFrame) {
   for (int k = 1; k <= 400; ++k) {  // 2 s more, with the VO
     const double t = 5.5 + k * 0.005;
     ASSERT_TRUE(after.add_imu(exact_imu(t, utime_of(t))).accepted);
-    if (k % 10 == 0) ASSERT_TRUE(after.add_vo(vo_at(t)).accepted);
+    if (k % 10 == 0) {
+      ASSERT_TRUE(after.add_vo(vo_at(t)).accepted);
+    }
   }
   const TruthSample e = truth_at(7.5);
   const auto end = error_state(after.state(), e.p, e.v, e.q, Vec3::Zero(), Vec3::Zero());

@@ -322,7 +322,9 @@ TEST(NavStateFile, RoundTripsExactlyAndRefusesDamage) {
     EXPECT_EQ(r->x.ba, s.x.ba);
     EXPECT_EQ(r->P, s.P);
     ASSERT_EQ(r->T_world_vo.has_value(), anchored);
-    if (anchored) EXPECT_LT((r->T_world_vo->matrix() - s.T_world_vo->matrix()).cwiseAbs().maxCoeff(), 1e-15);
+    if (anchored) {
+      EXPECT_LT((r->T_world_vo->matrix() - s.T_world_vo->matrix()).cwiseAbs().maxCoeff(), 1e-15);
+    }
   }
   std::ifstream in(path);
   const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

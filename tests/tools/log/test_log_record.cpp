@@ -70,7 +70,9 @@ TEST(Recorder, KeepsABurstThatTheDefaultQueueOf30Drops) {
     EXPECT_EQ(e.event_number, k);
     EXPECT_EQ(e.channel, "GT_POSE");
     EXPECT_EQ(bus::decode_bounded<aerie::gt_pose_t>(e.data.data(), e.data.size()).seq, k);  // in order, none lost
-    if (k > 0) EXPECT_GE(e.utime, events[k - 1].utime);
+    if (k > 0) {
+      EXPECT_GE(e.utime, events[k - 1].utime);
+    }
   }
   EXPECT_EQ(deep.bytes(), static_cast<int64_t>(500 * events[0].data.size()));
 }
