@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> trackers{"amcmr-ct"}, worlds{"room"}, vibrations{"on"}, controllers{"fuzzy"};
   std::vector<double> winds{0.0};
   std::string out_dir = "bench-landing";
-  Files files{"config/sim", "config/track_landing.yaml", "config/pilot.yaml"};
+  Files files{"config/sim", "config/track_landing.yaml", "config/pilot.yaml", ""};
   bool plots = true;
   std::string log_level = "warn";
   app.add_option("--runs", runs, "landings per configuration")->check(CLI::PositiveNumber);
