@@ -307,10 +307,9 @@ void write_folds(const fs::path& out, const Setup& setup, const std::vector<eval
   std::ofstream sum(out / "heldout_summary.csv");
   sum << "tracker,sequences,tuned_auc,tuned_p20,tuned_cle,heldout_auc,heldout_p20,heldout_cle\n";
   const int k = *std::max_element(fold.begin(), fold.end()) + 1;
-  std::vector<std::string> bases;
-  for (const auto& seq : sequences) bases.push_back(eval::base_name(seq.name));
-  std::sort(bases.begin(), bases.end());
-  const bool loo = k == std::unique(bases.begin(), bases.end()) - bases.begin();
+  std::vector<std::string> names;
+  for (const auto& seq : sequences) names.push_back(seq.name);
+  const bool loo = k == static_cast<int>(eval::distinct_sequences(names).size());
   spdlog::info("{}-fold cross-validation ({}): settings chosen on the other folds, scored on the fold held out", k,
                loo ? "leave one sequence out" : "sequence i in fold i mod k");
   spdlog::info("{:>18} {:>4} {:>9}  {:>27}  {:>27}", "tracker", "fold", "candidate", "tuned-on  AUC   P20    CLE",

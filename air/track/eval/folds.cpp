@@ -16,19 +16,25 @@ Figures mean_over(const std::vector<Figures>& per_sequence, const std::vector<si
 
 }  // namespace
 
-std::vector<int> assign_folds(const std::vector<std::string>& sequences, int k) {
-  std::vector<std::string> bases;
-  for (const auto& s : sequences) bases.push_back(base_name(s));
-  std::vector<std::string> distinct = bases;
+std::vector<std::string> distinct_sequences(const std::vector<std::string>& names) {
+  std::vector<std::string> distinct;
+  for (const auto& s : names) distinct.push_back(base_name(s));
   std::sort(distinct.begin(), distinct.end());
   distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  return distinct;
+}
+
+std::vector<int> assign_folds(const std::vector<std::string>& sequences, int k) {
+  const std::vector<std::string> distinct = distinct_sequences(sequences);
   const int n = static_cast<int>(distinct.size());
   if (k < 2 || k > n)
     throw std::invalid_argument(std::to_string(k) + " folds for " + std::to_string(n) +
                                 " sequences (need 2 <= folds <= sequences; folds = sequences is leave-one-out)");
   std::vector<int> fold(sequences.size());
-  for (size_t i = 0; i < bases.size(); ++i)
-    fold[i] = static_cast<int>(std::lower_bound(distinct.begin(), distinct.end(), bases[i]) - distinct.begin()) % k;
+  for (size_t i = 0; i < sequences.size(); ++i) {
+    const auto rank = std::lower_bound(distinct.begin(), distinct.end(), base_name(sequences[i])) - distinct.begin();
+    fold[i] = static_cast<int>(rank) % k;
+  }
   return fold;
 }
 

@@ -14,6 +14,8 @@ namespace aerie::track::eval {
 // fold, and k = the number of sequences is leave-one-sequence-out. Throws
 // std::invalid_argument unless 2 <= k <= that number.
 std::vector<int> assign_folds(const std::vector<std::string>& sequences, int k);
+// The distinct base_name()s of the names, sorted (byte order): the sequences the folds split.
+std::vector<std::string> distinct_sequences(const std::vector<std::string>& names);
 
 struct FoldResult {
   int fold = 0;
