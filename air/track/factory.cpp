@@ -206,6 +206,13 @@ std::unique_ptr<Tracker> make_eco(const util::Config& cfg) {
   in.read_in("samples", p.samples, 1, 200);
   in.read_in("update_interval", p.update_interval, 1, 1000);
   in.read("aberrance", p.aberrance);
+  in.read("joint_filter", p.joint_filter);
+  in.read("reg_floor", p.reg_floor);
+  in.read("reg_edge", p.reg_edge);
+  in.read_in("cg_iterations", p.cg_iterations, 1, 50);
+  in.read_in("init_cg_iterations", p.init_cg_iterations, 1, 200);
+  in.read_in("projection_steps", p.projection_steps, 0, 20);
+  in.read("projection_reg", p.projection_reg);
   in.read_in("newton_iterations", p.newton_iterations, 0, 50);
   in.read("colour_evidence", p.colour_evidence);
   in.read("lost_confidence", p.lost_confidence);

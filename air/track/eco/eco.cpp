@@ -10,6 +10,7 @@
 #include "air/track/dcf/fhog.hpp"
 #include "air/track/dcf/window.hpp"
 #include "air/track/eco/colour_names.hpp"
+#include "air/track/eco/joint_filter.hpp"
 #include "air/track/eco/newton.hpp"
 #include "air/track/eco/projection.hpp"
 
@@ -18,6 +19,7 @@ namespace {
 
 using Complex = std::complex<float>;
 constexpr int kHogBlock = kFhogChannels + 1;  // FHOG and the grey level
+constexpr int kGaussNewtonCg = 15;             // conjugate-gradient steps per Gauss-Newton step (ECO-HC's)
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("eco: " + what);
@@ -55,6 +57,11 @@ void EcoParams::validate() const {
   require(samples >= 1, "samples must be >= 1");
   require(update_interval >= 1, "update_interval must be >= 1");
   require(aberrance >= 0 && std::isfinite(aberrance), "aberrance must be >= 0");
+  require(reg_floor >= 0 && reg_edge >= reg_floor && std::isfinite(reg_edge),
+          "reg_floor and reg_edge must satisfy 0 <= reg_floor <= reg_edge");
+  require(cg_iterations >= 1 && init_cg_iterations >= 1, "cg_iterations and init_cg_iterations must be >= 1");
+  require(projection_steps >= 0 && projection_reg >= 0 && std::isfinite(projection_reg),
+          "projection_steps and projection_reg must be >= 0");
   require(newton_iterations >= 0, "newton_iterations must be >= 0");
   require(lost_confidence >= 0 && lost_confidence <= 1, "lost_confidence must be in [0, 1]");
   require(lost_after >= 1, "lost_after must be >= 1");
@@ -169,6 +176,11 @@ void EcoTracker::add_sample(const Detection& d, cv::Point2d shift) {
 void EcoTracker::train() {
   const auto& comps = samples_.components();
   const auto& w = samples_.weights();
+  if (p_.joint_filter) {
+    train_joint_filter(comps, w, regulariser_, frames_ == 0 ? p_.init_cg_iterations : p_.cg_iterations, filter_);
+    since_training_ = 0;
+    return;
+  }
   const size_t channels = comps[0].xf.size(), n = static_cast<size_t>(fw_.cells.area());
   filter_.resize(channels);
   const AdmmSettings admm{p_.lambda, p_.admm_iterations, 5, 3, 20};
@@ -212,6 +224,7 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   colour_ = p_.cn_dims > 0 && has_colour(frame, inside.empty() ? cv::Rect(0, 0, frame.cols, frame.rows) : inside);
 
   fw_ = filter_window(target_, p_.padding, p_.template_area, p_.cell, p_.mask_scale, p_.output_sigma);
+  filter_.clear();
 
   // Factorised convolution: each block's projection from the first window's cells (PCA).
   cv::Size cells;
@@ -219,6 +232,21 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   const cv::Mat raw = raw_features(window_patch, cells);
   hog_projection_ = pca_projection(raw.rowRange(0, kHogBlock), p_.hog_dims);
   cn_projection_ = colour_ ? pca_projection(raw.rowRange(kHogBlock, raw.rows), p_.cn_dims) : cv::Mat();
+  if (p_.joint_filter)  // SRDCF's regulariser, relative to this first sample's energy
+    regulariser_ = spatial_regulariser(fw_.cells, target_in_model() * (1.0 / p_.cell), p_.reg_floor, p_.reg_edge) *
+                   mean_energy({{spectra(projected(raw, cells)), fw_.yf}}, {1.0});
+  if (p_.joint_filter && p_.projection_steps > 0) {
+    // ECO's Gauss-Newton from the PCA: the projections learned with the filter on this window.
+    std::vector<cv::Mat> raw_xf(raw.rows);
+    for (int d = 0; d < raw.rows; ++d)
+      cv::dft(raw.row(d).reshape(1, cells.height).mul(fw_.hann), raw_xf[d], cv::DFT_COMPLEX_OUTPUT);
+    std::vector<ProjectionBlock> blocks{{0, hog_projection_}};
+    if (colour_) blocks.push_back({kHogBlock, cn_projection_});
+    learn_projection(raw_xf, fw_.yf, regulariser_, p_.projection_reg, p_.projection_steps, kGaussNewtonCg, blocks,
+                     filter_);
+    hog_projection_ = blocks[0].P;
+    if (colour_) cn_projection_ = blocks[1].P;
+  }
 
   // ECO's minimum weight: a sample older than twice the capacity at the learning rate.
   samples_ = SampleSpace(p_.samples, p_.learning_rate,

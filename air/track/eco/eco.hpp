@@ -51,6 +51,19 @@ struct EcoParams {
   double lambda = 1e-3;              // filter regularisation
   double mask_scale = 1.1;           // the filter's support is the target box times this
   int admm_iterations = 4;
+  // ECO's joint training instead (joint_filter.hpp): one filter over all channels, SRDCF's
+  // spatial regulariser in place of the mask (w^2 times the first sample's mean energy: reg_floor
+  // at the centre, reg_edge on the target's border), conjugate gradient warm-started from the
+  // last filter (init_cg_iterations on the first frame, cg_iterations at each training).
+  bool joint_filter = false;
+  double reg_floor = 1e-5;
+  double reg_edge = 0.1;
+  int cg_iterations = 5;
+  int init_cg_iterations = 50;
+  // With the joint filter, ECO's learned projection: projection_steps Gauss-Newton steps on the
+  // first frame from the PCA (0: the PCA is kept), its regularisation relative (joint_filter.hpp).
+  int projection_steps = 0;
+  double projection_reg = 1e-3;
   // Factorised convolution: channels after projection.
   int hog_dims = 10;                 // of FHOG + grey (32)
   int cn_dims = 3;                   // of the colour names (11), colour footage only
@@ -162,6 +175,7 @@ class EcoTracker : public Tracker {
   cv::Size2d target_;           // initial target size, image pixels
   double scale_ = 1;
   FilterWindow fw_;             // window, model size, cells, taper, support, label
+  cv::Mat regulariser_;         // w^2 of the joint filter
   cv::Mat hog_projection_, cn_projection_;  // D x C per block
 
   SampleSpace samples_{1, 1, 0};

@@ -5,11 +5,14 @@
 // re-detection when it comes back. (The shared motion tests are in test_trackers.cpp.)
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <complex>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "air/track/eco/colour_names.hpp"
 #include "air/track/eco/eco.hpp"
+#include "air/track/eco/joint_filter.hpp"
 #include "air/track/eco/newton.hpp"
 #include "air/track/eco/projection.hpp"
 #include "air/track/eco/sample_space.hpp"
@@ -214,6 +217,144 @@ TEST(Newton, ReachesTheSubCellMaximumOfTheContinuousResponse) {
 }
 
 namespace {
+// `count` samples of `channels` random real 8 x 6 signals (spectra), random labels, weights.
+std::vector<Sample> random_samples(int count, int channels, std::vector<double>& weights) {
+  cv::RNG rng(7);
+  std::vector<Sample> out;
+  weights.clear();
+  for (int j = 0; j < count; ++j) {
+    Sample s;
+    for (int c = 0; c <= channels; ++c) {
+      cv::Mat x(6, 8, CV_32F), f;
+      rng.fill(x, cv::RNG::NORMAL, 0, 1);
+      cv::dft(x, f, cv::DFT_COMPLEX_OUTPUT);
+      (c < channels ? s.xf.emplace_back() : s.yf) = f;
+    }
+    out.push_back(s);
+    weights.push_back(rng.uniform(0.2, 1.0));
+  }
+  return out;
+}
+}  // namespace
+
+// w^2 by hand: `floor` at the centre, `at_edge` on the target's half size from it along either
+// axis, w = a + (b - a) r^2 between and beyond.
+TEST(JointFilter, RegulariserByHand) {
+  const cv::Mat w2 = spatial_regulariser({9, 7}, {4, 2}, 0.01, 0.25);
+  EXPECT_NEAR(w2.at<float>(3, 4), 0.01, 1e-7);  // the centre, (8 / 2, 6 / 2)
+  EXPECT_NEAR(w2.at<float>(3, 6), 0.25, 1e-7);  // 2 cells right: r = 1
+  EXPECT_NEAR(w2.at<float>(4, 4), 0.25, 1e-7);  // 1 cell down: r = 1
+  EXPECT_NEAR(w2.at<float>(0, 0), std::pow(0.1 + 0.4 * (4.0 + 9.0), 2), 1e-3);  // r^2 = (4 / 2)^2 + (3 / 1)^2
+  EXPECT_THROW(spatial_regulariser({9, 7}, {4, 2}, 0.5, 0.25), std::invalid_argument);
+}
+
+// With a constant regulariser (floor = at_edge = l) each channel of one sample is ridge
+// regression per frequency; with one channel G = sum_j a_j conj(X_j) Y_j / (sum_j a_j |X_j|^2 +
+// l): the conjugate gradient reaches it.
+TEST(JointFilter, ConstantRegulariserIsRidgeRegressionPerFrequency) {
+  std::vector<double> a;
+  const std::vector<Sample> samples = random_samples(3, 1, a);
+  const double l = 5.0;
+  const cv::Mat w2(6, 8, CV_32F, cv::Scalar(l));
+  std::vector<cv::Mat> g;
+  EXPECT_LT(train_joint_filter(samples, a, w2, 20, g), 1e-5);
+  for (int k = 0; k < 48; ++k) {
+    std::complex<double> num = 0;
+    double den = l;
+    for (size_t j = 0; j < samples.size(); ++j) {
+      const cv::Vec2f x = samples[j].xf[0].at<cv::Vec2f>(k), y = samples[j].yf.at<cv::Vec2f>(k);
+      num += a[j] * std::conj(std::complex<double>(x[0], x[1])) * std::complex<double>(y[0], y[1]);
+      den += a[j] * (x[0] * x[0] + x[1] * x[1]);
+    }
+    const cv::Vec2f got = g[0].at<cv::Vec2f>(k);
+    EXPECT_NEAR(got[0], (num / den).real(), 1e-4 * std::abs(num / den) + 1e-6) << k;
+    EXPECT_NEAR(got[1], (num / den).imag(), 1e-4 * std::abs(num / den) + 1e-6) << k;
+  }
+}
+
+// Several channels and a spatial regulariser couple the frequencies: the conjugate gradient's
+// filter is the minimum of E, checked against random moves of every coefficient (brute force),
+// and more iterations from a warm start never raise E.
+TEST(JointFilter, ConjugateGradientMinimisesTheObjective) {
+  std::vector<double> a;
+  const std::vector<Sample> samples = random_samples(4, 3, a);
+  const cv::Mat w2 = spatial_regulariser({8, 6}, {3, 2}, 1e-3, 0.2);
+  std::vector<cv::Mat> g;
+  train_joint_filter(samples, a, w2, 2, g);
+  const double early = joint_objective(samples, a, w2, g);
+  EXPECT_LT(train_joint_filter(samples, a, w2, 300, g), 1e-4);
+  const double best = joint_objective(samples, a, w2, g);
+  EXPECT_LE(best, early);
+  cv::RNG rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<cv::Mat> moved;
+    for (const auto& gc : g) {  // a move of a real filter: the DFT of a random real signal
+      cv::Mat d(gc.size(), CV_32F), df;
+      rng.fill(d, cv::RNG::NORMAL, 0, 1e-2);
+      cv::dft(d, df, cv::DFT_COMPLEX_OUTPUT);
+      moved.push_back(gc + df);
+    }
+    EXPECT_GT(joint_objective(samples, a, w2, moved), best) << trial;
+  }
+}
+
+// ECO's Gauss-Newton learns a projection that fits the label better than the PCA it starts
+// from: E*(P) = min_G E(G, P) (the filter re-solved at each P) is lower at the learned P, and
+// is stationary there: its slope along random moves of P (central differences) is a small share
+// of the slope at the start.
+TEST(JointFilter, GaussNewtonLearnsABetterProjection) {
+  std::vector<double> unused;
+  const std::vector<Sample> raw = random_samples(1, 6, unused);  // 6 raw channels, one sample
+  const cv::Mat w2 = spatial_regulariser({8, 6}, {3, 2}, 1e-2, 0.2);
+  auto best_filter_energy = [&](const cv::Mat& P) {
+    const std::vector<Sample> s{Sample{project_spectra(raw[0].xf, {{0, P}}), raw[0].yf}};
+    std::vector<cv::Mat> g;
+    train_joint_filter(s, {1.0}, w2, 400, g);
+    return joint_objective(s, {1.0}, w2, g);
+  };
+  auto slope = [&](const cv::Mat& P, const cv::Mat& dir) {
+    const double eps = 1e-3;
+    return (best_filter_energy(P + eps * dir) - best_filter_energy(P - eps * dir)) / (2 * eps);
+  };
+  cv::Mat features(6, 48, CV_32F);  // the PCA start, from the raw channels' spatial values
+  for (int d = 0; d < 6; ++d) {
+    cv::Mat x;
+    cv::dft(raw[0].xf[d], x, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+    x.reshape(1, 1).copyTo(features.row(d));
+  }
+  const cv::Mat start = pca_projection(features, 2);
+  std::vector<ProjectionBlock> blocks{{0, start.clone()}};
+  std::vector<cv::Mat> g;
+  learn_projection(raw[0].xf, raw[0].yf, w2, 1e-6, 20, 30, blocks, g);
+  EXPECT_LT(best_filter_energy(blocks[0].P), 0.9 * best_filter_energy(start));
+  cv::RNG rng(5);
+  for (int trial = 0; trial < 3; ++trial) {
+    cv::Mat dir(6, 2, CV_32F);
+    rng.fill(dir, cv::RNG::NORMAL, 0, 1);
+    EXPECT_LT(std::abs(slope(blocks[0].P, dir)), 0.05 * std::abs(slope(start, dir)) + 1e-6) << trial;
+  }
+}
+
+// The tracker with the joint filter: the same box on the training frame, and a moving target
+// followed to within a few pixels.
+TEST(Eco, JointFilterTracksAMovingTarget) {
+  const Scene scene({240, 180}, {40, 32});
+  EcoParams p;
+  p.joint_filter = true;
+  EcoTracker t(p);
+  Motion m;
+  m.centre = {90, 80};
+  t.init(scene.render(m), scene.box(m));
+  for (int i = 1; i <= 30; ++i) {
+    m.centre = {90 + 1.5 * i, 80 + 0.5 * i};
+    const TrackState s = t.update(scene.render(m));
+    ASSERT_NEAR(s.pose.x, m.centre.x, 3) << i;
+    ASSERT_NEAR(s.pose.y, m.centre.y, 3) << i;
+    EXPECT_FALSE(s.lost) << i;
+  }
+}
+
+namespace {
 
 // The target moves right at 2 px per frame; from frame `out` to `back` it is outside the image
 // (far beyond the right border), then it reappears at `reappear`.
@@ -332,6 +473,10 @@ TEST(Eco, WithoutTheWholeImageSearchTheFarTargetStaysLost) {
 TEST(Eco, SameInputSameTrack) {
   const ExitScene e;
   EXPECT_EQ(exit_track(e, EcoParams{}, 50), exit_track(e, EcoParams{}, 50));
+  EcoParams joint;  // ECO's own training, with its learned projection
+  joint.joint_filter = true;
+  joint.projection_steps = 3;
+  EXPECT_EQ(exit_track(e, joint, 50), exit_track(e, joint, 50));
 }
 
 TEST(Eco, BadParametersAreNamed) {
@@ -351,6 +496,10 @@ TEST(Eco, BadParametersAreNamed) {
   EXPECT_NE(message([](EcoParams& p) { p.verify_learn_similarity = 2; }).find("verify_learn_similarity"),
             std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.verify_interval = 0; }).find("verify_interval"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.reg_edge = p.reg_floor / 2; }).find("reg_floor <= reg_edge"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.reg_floor = NAN; }).find("reg_floor"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.cg_iterations = 0; }).find("cg_iterations"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.projection_reg = -1; }).find("projection_reg"), std::string::npos);
   EXPECT_EQ(message([](EcoParams&) {}), "accepted");
 }
 

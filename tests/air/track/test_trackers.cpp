@@ -200,6 +200,9 @@ TEST(Factory, NamesUnknownTrackersAndParameters) {
   EXPECT_THROW(make_tracker("amcmr-ct", aerie::util::Config::parse("reject_ratio: 1.5")), std::invalid_argument);
   EXPECT_THROW(make_tracker("am3", aerie::util::Config::parse("selected: 300")), std::invalid_argument);
   EXPECT_NO_THROW(make_tracker("amcmr-ct", aerie::util::Config::parse("reject_ratio: [0.8, 0.9]\nmax_levels: 2")));
+  EXPECT_THROW(make_tracker("eco", aerie::util::Config::parse("joint_filter: true\nprojection_steps: 50")),
+               std::invalid_argument);  // bounded: the first frame's work
+  EXPECT_NO_THROW(make_tracker("eco", aerie::util::Config::parse("joint_filter: true\nprojection_steps: 10")));
   for (const auto& n : opencv_tracker_names()) EXPECT_TRUE(is_known_tracker(n)) << n;
 }
 
