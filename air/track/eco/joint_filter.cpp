@@ -193,10 +193,6 @@ double joint_objective(const std::vector<Sample>& comps, const std::vector<doubl
   return e;
 }
 
-}  // namespace aerie::track
-
-namespace aerie::track {
-
 std::vector<cv::Mat> project_spectra(const std::vector<cv::Mat>& raw_xf, const std::vector<ProjectionBlock>& blocks) {
   std::vector<cv::Mat> z;
   for (const auto& b : blocks) {

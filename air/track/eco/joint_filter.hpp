@@ -36,10 +36,6 @@ double train_joint_filter(const std::vector<Sample>& components, const std::vect
 double joint_objective(const std::vector<Sample>& components, const std::vector<double>& weights,
                        const cv::Mat& w2, const std::vector<cv::Mat>& filter);
 
-}  // namespace aerie::track
-
-namespace aerie::track {
-
 // ECO's first frame (CVPR 2017, sec. 3.1, eqs. 6-7): the projection learned with the filter.
 // Gauss-Newton on E(G, P) = || sum_c (P^T X)^c G^c - Y ||^2 + reg(G) + mu ||P||_F^2 for one
 // sample X (the spectra of the D raw channels, windowed), each step linearised around
