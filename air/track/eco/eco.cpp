@@ -232,26 +232,27 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   const cv::Mat raw = raw_features(window_patch, cells);
   hog_projection_ = pca_projection(raw.rowRange(0, kHogBlock), p_.hog_dims);
   cn_projection_ = colour_ ? pca_projection(raw.rowRange(kHogBlock, raw.rows), p_.cn_dims) : cv::Mat();
+  Sample first{spectra(projected(raw, cells)), fw_.yf};
   if (p_.joint_filter)  // SRDCF's regulariser, relative to this first sample's energy
     regulariser_ = spatial_regulariser(fw_.cells, target_in_model() * (1.0 / p_.cell), p_.reg_floor, p_.reg_edge) *
-                   mean_energy({{spectra(projected(raw, cells)), fw_.yf}}, {1.0});
+                   mean_energy({first}, {1.0});
   if (p_.joint_filter && p_.projection_steps > 0) {
     // ECO's Gauss-Newton from the PCA: the projections learned with the filter on this window.
-    std::vector<cv::Mat> raw_xf(raw.rows);
-    for (int d = 0; d < raw.rows; ++d)
-      cv::dft(raw.row(d).reshape(1, cells.height).mul(fw_.hann), raw_xf[d], cv::DFT_COMPLEX_OUTPUT);
+    std::vector<cv::Mat> raw_maps;
+    for (int d = 0; d < raw.rows; ++d) raw_maps.push_back(raw.row(d).reshape(1, cells.height));
     std::vector<ProjectionBlock> blocks{{0, hog_projection_}};
     if (colour_) blocks.push_back({kHogBlock, cn_projection_});
-    learn_projection(raw_xf, fw_.yf, regulariser_, p_.projection_reg, p_.projection_steps, kGaussNewtonCg, blocks,
-                     filter_);
+    learn_projection(spectra(raw_maps), fw_.yf, regulariser_, p_.projection_reg, p_.projection_steps, kGaussNewtonCg,
+                     blocks, filter_);
     hog_projection_ = blocks[0].P;
     if (colour_) cn_projection_ = blocks[1].P;
+    first.xf = spectra(projected(raw, cells));  // the first sample in the learned projection
   }
 
   // ECO's minimum weight: a sample older than twice the capacity at the learning rate.
   samples_ = SampleSpace(p_.samples, p_.learning_rate,
                          p_.learning_rate * std::pow(1 - p_.learning_rate, 2.0 * p_.samples));
-  samples_.add({spectra(projected(raw, cells)), fw_.yf});
+  samples_.add(first);
   train();
   scale_filter_ = ScaleFilter(p_.scale_filter(), target_);
   scale_filter_.learn(frame, pos_, scale_, 1.0);

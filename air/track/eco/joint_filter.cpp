@@ -67,6 +67,31 @@ void check(const std::vector<Sample>& comps, const std::vector<double>& weights,
     throw std::invalid_argument("joint filter: the regulariser is not one CV_32F value per frequency");
 }
 
+// The Jacobi preconditioner of the normal equations: sum_j a_j |X_j^c|^2 + mean(w2) per channel,
+// in both parts of a CV_32FC2 mat so that a residual spectrum is divided by it directly.
+Spectra jacobi_diagonal(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2) {
+  const size_t n = w2.total();
+  const float reg_mean = static_cast<float>(cv::mean(w2)[0]);
+  Spectra diag;
+  for (size_t c = 0; c < comps[0].xf.size(); ++c) {
+    cv::Mat d(w2.size(), CV_32F, cv::Scalar(reg_mean));
+    float* e = d.ptr<float>();
+    for (size_t j = 0; j < comps.size(); ++j) {
+      const float* x = comps[j].xf[c].ptr<float>();
+      const float a = static_cast<float>(weights[j]);
+      for (size_t k = 0; k < n; ++k) e[k] += a * (x[2 * k] * x[2 * k] + x[2 * k + 1] * x[2 * k + 1]);
+    }
+    cv::merge(std::vector<cv::Mat>{d, d}, diag.emplace_back());
+  }
+  return diag;
+}
+
+Spectra divided(const Spectra& r, const Spectra& diag) {
+  Spectra z(r.size());
+  for (size_t c = 0; c < r.size(); ++c) cv::divide(r[c], diag[c], z[c]);
+  return z;
+}
+
 Spectra clones(const Spectra& s) {
   Spectra out;
   for (const auto& m : s) out.push_back(m.clone());
@@ -130,13 +155,9 @@ double train_joint_filter(const std::vector<Sample>& comps, const std::vector<do
                           int iterations, std::vector<cv::Mat>& filter) {
   check(comps, weights, w2);
   const size_t channels = comps[0].xf.size(), n = w2.total();
-  // b = sum_j a_j conj(X_j) Y_j and the Jacobi preconditioner sum_j a_j |X_j|^2 + mean(w2).
+  // b = sum_j a_j conj(X_j) Y_j.
   Spectra b = zeros_like(comps[0].xf);
-  std::vector<cv::Mat> diag(channels);
-  const float reg_mean = static_cast<float>(cv::mean(w2)[0]);
   for (size_t c = 0; c < channels; ++c) {
-    diag[c] = cv::Mat(w2.size(), CV_32F, cv::Scalar(reg_mean));
-    float* d = diag[c].ptr<float>();
     float* o = b[c].ptr<float>();
     for (size_t j = 0; j < comps.size(); ++j) {
       const float* x = comps[j].xf[c].ptr<float>();
@@ -145,19 +166,11 @@ double train_joint_filter(const std::vector<Sample>& comps, const std::vector<do
       for (size_t k = 0; k < n; ++k) {
         o[2 * k] += a * (x[2 * k] * y[2 * k] + x[2 * k + 1] * y[2 * k + 1]);
         o[2 * k + 1] += a * (x[2 * k] * y[2 * k + 1] - x[2 * k + 1] * y[2 * k]);
-        d[k] += a * (x[2 * k] * x[2 * k] + x[2 * k + 1] * x[2 * k + 1]);
       }
     }
   }
-  auto precondition = [&](const Spectra& r) {
-    Spectra z(channels);
-    for (size_t c = 0; c < channels; ++c) {
-      cv::Mat d2;
-      cv::merge(std::vector<cv::Mat>{diag[c], diag[c]}, d2);
-      cv::divide(r[c], d2, z[c]);
-    }
-    return z;
-  };
+  const Spectra diag = jacobi_diagonal(comps, weights, w2);
+  auto precondition = [&](const Spectra& r) { return divided(r, diag); };
   auto apply = [&](const Spectra& g) {
     Spectra out = zeros_like(g);
     add_data(comps, weights, g, out);
@@ -236,13 +249,8 @@ double learn_projection(const std::vector<cv::Mat>& raw_xf, const cv::Mat& yf, c
     }
     const Spectra fi = clones(filter);  // the linearisation point, fixed while x moves
     // The Jacobi preconditioner: |z^c|^2 + mean(w2) for G, sum_k |x^d G_i^c|^2 (+ mu) for dP.
-    std::vector<cv::Mat> diag_g(z.size()), diag_dp;
-    for (size_t c = 0; c < z.size(); ++c) {
-      cv::Mat e;
-      cv::mulSpectrums(z[c], z[c], e, 0, true);  // |z|^2 in the real part
-      cv::extractChannel(e, diag_g[c], 0);
-      diag_g[c] += cv::mean(w2)[0];
-    }
+    const Spectra diag_g = jacobi_diagonal(sample, one, w2);
+    std::vector<cv::Mat> diag_dp;
     double dp_mean = 0;
     int dp_count = 0;
     for (size_t b = 0, c = 0; b < blocks.size(); ++b) {
@@ -299,12 +307,7 @@ double learn_projection(const std::vector<cv::Mat>& raw_xf, const cv::Mat& yf, c
     };
     auto apply = [&](const Step& v) { return adjoint(forward(v), &v); };
     auto precondition = [&](const Step& r) {
-      Step out{Spectra(z.size()), {}};
-      for (size_t c = 0; c < z.size(); ++c) {
-        cv::Mat d2;
-        cv::merge(std::vector<cv::Mat>{diag_g[c], diag_g[c]}, d2);
-        cv::divide(r.g[c], d2, out.g[c]);
-      }
+      Step out{divided(r.g, diag_g), {}};
       for (size_t b = 0; b < blocks.size(); ++b) out.dp.push_back(r.dp[b] / diag_dp[b]);
       return out;
     };

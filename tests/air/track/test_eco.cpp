@@ -335,8 +335,7 @@ TEST(JointFilter, GaussNewtonLearnsABetterProjection) {
   }
 }
 
-// The tracker with the joint filter: the same box on the training frame, and a moving target
-// followed to within a few pixels.
+// The tracker with the joint filter: a moving target followed to within a few pixels.
 TEST(Eco, JointFilterTracksAMovingTarget) {
   const Scene scene({240, 180}, {40, 32});
   EcoParams p;
