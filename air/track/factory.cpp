@@ -213,6 +213,10 @@ std::unique_ptr<Tracker> make_eco(const util::Config& cfg) {
   in.read_in("init_cg_iterations", p.init_cg_iterations, 1, 200);
   in.read_in("projection_steps", p.projection_steps, 0, 20);
   in.read("projection_reg", p.projection_reg);
+  in.read("temporal_reg", p.temporal_reg);
+  in.read("variation_gain", p.variation_gain);
+  in.read("variation_reg", p.variation_reg);
+  in.read("variation_limit", p.variation_limit);
   in.read_in("newton_iterations", p.newton_iterations, 0, 50);
   in.read("colour_evidence", p.colour_evidence);
   in.read("lost_confidence", p.lost_confidence);

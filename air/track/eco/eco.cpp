@@ -5,6 +5,8 @@
 #include <complex>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "air/track/dcf/cf_params.hpp"
 #include "air/track/dcf/fhog.hpp"
@@ -62,6 +64,9 @@ void EcoParams::validate() const {
   require(cg_iterations >= 1 && init_cg_iterations >= 1, "cg_iterations and init_cg_iterations must be >= 1");
   require(projection_steps >= 0 && projection_reg >= 0 && std::isfinite(projection_reg),
           "projection_steps and projection_reg must be >= 0");
+  for (const auto& [value, name] : {std::pair{temporal_reg, "temporal_reg"}, {variation_gain, "variation_gain"},
+                                     {variation_reg, "variation_reg"}, {variation_limit, "variation_limit"}})
+    require(value >= 0 && std::isfinite(value), std::string(name) + " must be finite and >= 0");
   require(newton_iterations >= 0, "newton_iterations must be >= 0");
   require(lost_confidence >= 0 && lost_confidence <= 1, "lost_confidence must be in [0, 1]");
   require(lost_after >= 1, "lost_after must be >= 1");
@@ -171,13 +176,30 @@ void EcoTracker::add_sample(const Detection& d, cv::Point2d shift) {
   samples_.add(s);
 }
 
+cv::Mat EcoTracker::centred_response(const Detection& d, cv::Point2d shift) const {
+  const cv::Point2d centre((fw_.cells.width - 1) / 2.0, (fw_.cells.height - 1) / 2.0);
+  cv::Mat r;
+  cv::dft(shifted(d.rf, centre - shift), r, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+  return r / std::max(d.peak, 1e-12);
+}
+
 // The filter from the whole sample space: per channel sum_m pi_m Y_m conj(X_m) and
 // sum_m pi_m |X_m|^2, then CSR-DCF's constrained solution.
 void EcoTracker::train() {
   const auto& comps = samples_.components();
   const auto& w = samples_.weights();
   if (p_.joint_filter) {
-    train_joint_filter(comps, w, regulariser_, frames_ == 0 ? p_.init_cg_iterations : p_.cg_iterations, filter_);
+    // AutoTrack's regularisation from this frame's response variation (none on the first frame).
+    cv::Mat w2 = regulariser_;
+    TemporalPrior prior;
+    if (frames_ > 0 && p_.variation_reg > 0 && !variation_.local.empty())
+      w2 = varied_regulariser(regulariser_ / energy_, variation_, target_in_model() * (1.0 / p_.cell), p_.variation_reg) *
+           energy_;
+    if (frames_ > 0 && p_.temporal_reg > 0) {
+      prior.theta = temporal_weight(p_.temporal_reg, p_.variation_gain, variation_.global) * energy_;
+      for (const auto& g : filter_) prior.reference.push_back(g.clone());  // the filter moves in place
+    }
+    train_joint_filter(comps, w, w2, frames_ == 0 ? p_.init_cg_iterations : p_.cg_iterations, filter_, prior);
     since_training_ = 0;
     return;
   }
@@ -233,9 +255,12 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   hog_projection_ = pca_projection(raw.rowRange(0, kHogBlock), p_.hog_dims);
   cn_projection_ = colour_ ? pca_projection(raw.rowRange(kHogBlock, raw.rows), p_.cn_dims) : cv::Mat();
   Sample first{spectra(projected(raw, cells)), fw_.yf};
-  if (p_.joint_filter)  // SRDCF's regulariser, relative to this first sample's energy
-    regulariser_ = spatial_regulariser(fw_.cells, target_in_model() * (1.0 / p_.cell), p_.reg_floor, p_.reg_edge) *
-                   mean_energy({first}, {1.0});
+  last_response_ = cv::Mat();
+  variation_ = {};
+  if (p_.joint_filter) {  // SRDCF's regulariser, relative to this first sample's energy
+    energy_ = std::max(mean_energy({first}, {1.0}), 1e-30);
+    regulariser_ = spatial_regulariser(fw_.cells, target_in_model() * (1.0 / p_.cell), p_.reg_floor, p_.reg_edge) * energy_;
+  }
   if (p_.joint_filter && p_.projection_steps > 0) {
     // ECO's Gauss-Newton from the PCA: the projections learned with the filter on this window.
     std::vector<cv::Mat> raw_maps;
@@ -362,14 +387,24 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   const double px_per_cell = p_.cell * fw_.window.width * scale_ / fw_.model.width;
   pos_.x = std::clamp(d.centre.x + shift.x * px_per_cell, 0.0, frame.cols - 1.0);
   pos_.y = std::clamp(d.centre.y + shift.y * px_per_cell, 0.0, frame.rows - 1.0);
+  bool abnormal = false;  // AutoTrack: a response that changed this much is a failure, not learned from
+  if (p_.joint_filter && spatio_temporal()) {
+    const cv::Mat centred = centred_response(d, shift);
+    variation_ = last_response_.empty() ? ResponseVariation{}
+                                        : response_variation(last_response_, centred, target_in_model() * (1.0 / p_.cell));
+    last_response_ = centred;
+    abnormal = p_.variation_limit > 0 && variation_.global > p_.variation_limit;
+  }
   if (confident) {
     // The running means of the reliability follow confident frames only, so that a long loss
     // does not lower the bar it is measured against.
     mean_peak_ += p_.confidence_rate * (d.peak - mean_peak_);
     mean_apce_ += p_.confidence_rate * (d.apce - mean_apce_);
     scale_ = std::clamp(scale_ * scale_filter_.best_change(frame, pos_, scale_), p_.min_scale, p_.max_scale);
-    add_sample(d, shift);
-    if (++since_training_ >= p_.update_interval) train();
+    if (!abnormal) {
+      add_sample(d, shift);
+      if (++since_training_ >= p_.update_interval) train();
+    }
     scale_filter_.learn(frame, pos_, scale_, p_.scale_learning_rate);
     if (p_.hist_weight > 0)
       colour_model_.learn(subwindow(frame, pos_, fw_.window * scale_, fw_.model), target_in_model(), p_.hist_learning_rate);

@@ -16,6 +16,8 @@
 //  * aberrance repression (ARCF, Huang, Fu et al. 2019): the training label mixes the ideal
 //    Gaussian with the previous response map aligned on its peak, which penalises sudden changes
 //    of the response between frames;
+//  * optionally ECO's own training (one joint filter, SRDCF's regulariser, conjugate gradient;
+//    joint_filter.hpp) with AutoTrack's spatio-temporal regularisation (spatio_temporal.hpp);
 //  * colour: Staple's foreground/background histogram likelihood merged with the response (as dcf);
 //  * scale: DSST's scale filter;
 //  * loss and re-detection: the state says lost once the response's peak or APCE has stayed far
@@ -37,6 +39,7 @@
 #include "air/track/dcf/scale_filter.hpp"
 #include "air/track/dcf/window.hpp"
 #include "air/track/eco/sample_space.hpp"
+#include "air/track/eco/spatio_temporal.hpp"
 #include "air/track/eco/verifier.hpp"
 #include "air/track/tracker.hpp"
 
@@ -64,6 +67,16 @@ struct EcoParams {
   // first frame from the PCA (0: the PCA is kept), its regularisation relative (joint_filter.hpp).
   int projection_steps = 0;
   double projection_reg = 1e-3;
+  // With the joint filter, AutoTrack's automatic spatio-temporal regularisation
+  // (spatio_temporal.hpp), from the change of the response between frames: a temporal prior
+  // theta ||G - G_last||^2 with theta = temporal_reg / (1 + log(1 + variation_gain ||Pi||)) x the
+  // first sample's mean energy (0: none); variation_reg x log(1 + Pi) added to SRDCF's w on the
+  // target's cells (0: none); no sample learned from a frame whose ||Pi|| exceeds
+  // variation_limit (0: no limit).
+  double temporal_reg = 0;
+  double variation_gain = 1;
+  double variation_reg = 0;
+  double variation_limit = 0;
   // Factorised convolution: channels after projection.
   int hog_dims = 10;                 // of FHOG + grey (32)
   int cn_dims = 3;                   // of the colour names (11), colour footage only
@@ -159,6 +172,9 @@ class EcoTracker : public Tracker {
   cv::Point2d peak_offset(const Detection& d) const;  // sub-cell peak as a shift in cells
   bool search_whole_image(const cv::Mat& frame, Detection& best, double& confidence) const;
   void add_sample(const Detection& d, cv::Point2d shift_cells);
+  // The filter's response of d, its peak moved to the grid's centre, scaled to peak 1.
+  cv::Mat centred_response(const Detection& d, cv::Point2d shift_cells) const;
+  bool spatio_temporal() const { return p_.temporal_reg > 0 || p_.variation_reg > 0 || p_.variation_limit > 0; }
   cv::Size2d target_in_model() const { return target_ * (fw_.model.width / fw_.window.width); }
   void train();
   // The verifier's patch of the box centred `offset` image pixels from the centre of a window
@@ -175,7 +191,10 @@ class EcoTracker : public Tracker {
   cv::Size2d target_;           // initial target size, image pixels
   double scale_ = 1;
   FilterWindow fw_;             // window, model size, cells, taper, support, label
-  cv::Mat regulariser_;         // w^2 of the joint filter
+  cv::Mat regulariser_;         // w^2 of the joint filter, x energy_
+  double energy_ = 1;           // the first sample's mean energy
+  cv::Mat last_response_;       // centred_response of the last frame (AutoTrack)
+  ResponseVariation variation_; // from it to this frame's
   cv::Mat hog_projection_, cn_projection_;  // D x C per block
 
   SampleSpace samples_{1, 1, 0};

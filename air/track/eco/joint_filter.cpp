@@ -60,18 +60,27 @@ void add_data(const std::vector<Sample>& comps, const std::vector<double>& weigh
   }
 }
 
-void check(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2) {
+void check(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2,
+           const TemporalPrior& prior = {}) {
   if (comps.empty() || comps.size() != weights.size() || comps[0].xf.empty())
     throw std::invalid_argument("joint filter: no samples, or not one weight per sample");
   if (comps[0].xf[0].size() != w2.size() || w2.type() != CV_32F)
     throw std::invalid_argument("joint filter: the regulariser is not one CV_32F value per frequency");
+  if (!(prior.theta >= 0 && std::isfinite(prior.theta)))
+    throw std::invalid_argument("joint filter: the temporal prior's theta must be finite and >= 0");
+  if (!prior.reference.empty() &&
+      (prior.reference.size() != comps[0].xf.size() || prior.reference[0].size() != w2.size()))
+    throw std::invalid_argument("joint filter: the temporal prior's reference is not one spectrum per channel");
 }
 
-// The Jacobi preconditioner of the normal equations: sum_j a_j |X_j^c|^2 + mean(w2) per channel,
+bool active(const TemporalPrior& prior) { return prior.theta > 0 && !prior.reference.empty(); }
+
+// The Jacobi preconditioner of the normal equations: sum_j a_j |X_j^c|^2 + mean(w2) + theta per channel,
 // in both parts of a CV_32FC2 mat so that a residual spectrum is divided by it directly.
-Spectra jacobi_diagonal(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2) {
+Spectra jacobi_diagonal(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2,
+                        double theta = 0) {
   const size_t n = w2.total();
-  const float reg_mean = static_cast<float>(cv::mean(w2)[0]);
+  const float reg_mean = static_cast<float>(cv::mean(w2)[0] + theta);
   Spectra diag;
   for (size_t c = 0; c < comps[0].xf.size(); ++c) {
     cv::Mat d(w2.size(), CV_32F, cv::Scalar(reg_mean));
@@ -152,8 +161,9 @@ cv::Mat spatial_regulariser(cv::Size cells, cv::Size2d target_cells, double floo
 }
 
 double train_joint_filter(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2,
-                          int iterations, std::vector<cv::Mat>& filter) {
-  check(comps, weights, w2);
+                          int iterations, std::vector<cv::Mat>& filter, const TemporalPrior& prior) {
+  check(comps, weights, w2, prior);
+  const double theta = active(prior) ? prior.theta : 0.0;
   const size_t channels = comps[0].xf.size(), n = w2.total();
   // b = sum_j a_j conj(X_j) Y_j.
   Spectra b = zeros_like(comps[0].xf);
@@ -169,12 +179,14 @@ double train_joint_filter(const std::vector<Sample>& comps, const std::vector<do
       }
     }
   }
-  const Spectra diag = jacobi_diagonal(comps, weights, w2);
+  if (theta > 0) axpy_spectra(b, theta, prior.reference);  // + theta G_ref
+  const Spectra diag = jacobi_diagonal(comps, weights, w2, theta);
   auto precondition = [&](const Spectra& r) { return divided(r, diag); };
   auto apply = [&](const Spectra& g) {
     Spectra out = zeros_like(g);
     add_data(comps, weights, g, out);
     add_regularisation(w2, g, out);
+    if (theta > 0) axpy_spectra(out, theta, g);
     return out;
   };
   if (filter.size() != channels || filter[0].size() != w2.size()) filter = precondition(b);
@@ -186,8 +198,8 @@ double train_joint_filter(const std::vector<Sample>& comps, const std::vector<do
 }
 
 double joint_objective(const std::vector<Sample>& comps, const std::vector<double>& weights, const cv::Mat& w2,
-                       const std::vector<cv::Mat>& filter) {
-  check(comps, weights, w2);
+                       const std::vector<cv::Mat>& filter, const TemporalPrior& prior) {
+  check(comps, weights, w2, prior);
   double e = 0;
   for (size_t j = 0; j < comps.size(); ++j) {
     cv::Mat s = -comps[j].yf;
@@ -203,6 +215,11 @@ double joint_objective(const std::vector<Sample>& comps, const std::vector<doubl
     cv::dft(g, spatial, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
     e += static_cast<double>(w2.total()) * spatial.mul(spatial).dot(w2);
   }
+  if (active(prior))
+    for (size_t c = 0; c < filter.size(); ++c) {
+      const cv::Mat d = filter[c] - prior.reference[c];
+      e += prior.theta * d.dot(d);
+    }
   return e;
 }
 

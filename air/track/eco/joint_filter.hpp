@@ -8,7 +8,10 @@
 // costs w^2 there. The normal equations
 //   sum_j a_j conj(X_j^c) sum_c' X_j^c' G^c' + DFT(w^2 . IDFT(G^c)) = sum_j a_j conj(X_j^c) Y_j
 // are solved by conjugate gradient with a diagonal (Jacobi) preconditioner, warm-started from
-// the last filter, as ECO does between its sparse updates.
+// the last filter, as ECO does between its sparse updates. With a temporal prior (STRCF, Li et
+// al., CVPR 2018; AutoTrack's theta, Li, Fu et al., CVPR 2020) E gains theta ||G - G_ref||^2,
+// which keeps the filter near a reference (the last filter): theta G joins the left side and
+// theta G_ref the right.
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -26,15 +29,22 @@ cv::Mat spatial_regulariser(cv::Size cells, cv::Size2d target_cells, double floo
 // regulariser's floor and edge are relative to the features' scale.
 double mean_energy(const std::vector<Sample>& components, const std::vector<double>& weights);
 
+// theta ||G - reference||^2 (off while theta is 0 or the reference empty).
+struct TemporalPrior {
+  double theta = 0;
+  std::vector<cv::Mat> reference;  // one CV_32FC2 spectrum per channel, like the filter
+};
+
 // `iterations` steps of preconditioned conjugate gradient on the normal equations above, from
 // `filter` (one CV_32FC2 spectrum per channel; empty: from the preconditioner's solution).
 // Returns the relative residual ||b - A G|| / ||b|| after the last step.
 double train_joint_filter(const std::vector<Sample>& components, const std::vector<double>& weights,
-                          const cv::Mat& w2, int iterations, std::vector<cv::Mat>& filter);
+                          const cv::Mat& w2, int iterations, std::vector<cv::Mat>& filter,
+                          const TemporalPrior& prior = {});
 
 // E(G) (tests).
 double joint_objective(const std::vector<Sample>& components, const std::vector<double>& weights,
-                       const cv::Mat& w2, const std::vector<cv::Mat>& filter);
+                       const cv::Mat& w2, const std::vector<cv::Mat>& filter, const TemporalPrior& prior = {});
 
 // ECO's first frame (CVPR 2017, sec. 3.1, eqs. 6-7): the projection learned with the filter.
 // Gauss-Newton on E(G, P) = || sum_c (P^T X)^c G^c - Y ||^2 + reg(G) + mu ||P||_F^2 for one

@@ -16,6 +16,7 @@
 #include "air/track/eco/newton.hpp"
 #include "air/track/eco/projection.hpp"
 #include "air/track/eco/sample_space.hpp"
+#include "air/track/eco/spatio_temporal.hpp"
 #include "air/track/eco/verifier.hpp"
 #include "tests/air/track/synthetic.hpp"
 
@@ -272,30 +273,106 @@ TEST(JointFilter, ConstantRegulariserIsRidgeRegressionPerFrequency) {
   }
 }
 
+// With a temporal prior theta ||G - G0||^2 as well, per frequency G = (sum_j a_j conj(X_j) Y_j +
+// theta G0) / (sum_j a_j |X_j|^2 + l + theta) (STRCF's closed form for one channel); a very
+// large theta keeps G0.
+TEST(JointFilter, TemporalPriorIsRidgeTowardsTheReferencePerFrequency) {
+  std::vector<double> a;
+  const std::vector<Sample> samples = random_samples(3, 1, a);
+  const double l = 5.0;
+  const cv::Mat w2(6, 8, CV_32F, cv::Scalar(l));
+  cv::Mat r0(6, 8, CV_32F), g0;  // a real filter's spectrum
+  cv::RNG(9).fill(r0, cv::RNG::NORMAL, 0, 0.3);
+  cv::dft(r0, g0, cv::DFT_COMPLEX_OUTPUT);
+  for (const double theta : {2.0, 1e7}) {
+    std::vector<cv::Mat> g{g0.clone()};  // from the reference, as ECO warm-starts
+    EXPECT_LT(train_joint_filter(samples, a, w2, 20, g, {theta, {g0}}), 1e-5);
+    for (int k = 0; k < 48; ++k) {
+      const cv::Vec2f r = g0.at<cv::Vec2f>(k);
+      std::complex<double> num = theta * std::complex<double>(r[0], r[1]);
+      double den = l + theta;
+      for (size_t j = 0; j < samples.size(); ++j) {
+        const cv::Vec2f x = samples[j].xf[0].at<cv::Vec2f>(k), y = samples[j].yf.at<cv::Vec2f>(k);
+        num += a[j] * std::conj(std::complex<double>(x[0], x[1])) * std::complex<double>(y[0], y[1]);
+        den += a[j] * (x[0] * x[0] + x[1] * x[1]);
+      }
+      const cv::Vec2f got = g[0].at<cv::Vec2f>(k);
+      EXPECT_NEAR(got[0], (num / den).real(), 1e-4 * std::abs(num / den) + 1e-6) << theta << " " << k;
+      EXPECT_NEAR(got[1], (num / den).imag(), 1e-4 * std::abs(num / den) + 1e-6) << theta << " " << k;
+      if (theta > 1e6) {
+        EXPECT_NEAR(got[0], r[0], 1e-4) << k;
+      }
+    }
+  }
+  std::vector<cv::Mat> g;
+  EXPECT_THROW(train_joint_filter(samples, a, w2, 20, g, {NAN, {g0}}), std::invalid_argument);
+  EXPECT_THROW(train_joint_filter(samples, a, w2, 20, g, {1.0, {g0, g0}}), std::invalid_argument);
+}
+
 // Several channels and a spatial regulariser couple the frequencies: the conjugate gradient's
 // filter is the minimum of E, checked against random moves of every coefficient (brute force),
-// and more iterations from a warm start never raise E.
+// and more iterations from a warm start never raise E; so too with a temporal prior.
 TEST(JointFilter, ConjugateGradientMinimisesTheObjective) {
   std::vector<double> a;
   const std::vector<Sample> samples = random_samples(4, 3, a);
   const cv::Mat w2 = spatial_regulariser({8, 6}, {3, 2}, 1e-3, 0.2);
-  std::vector<cv::Mat> g;
-  train_joint_filter(samples, a, w2, 2, g);
-  const double early = joint_objective(samples, a, w2, g);
-  EXPECT_LT(train_joint_filter(samples, a, w2, 300, g), 1e-4);
-  const double best = joint_objective(samples, a, w2, g);
-  EXPECT_LE(best, early);
-  cv::RNG rng(3);
-  for (int trial = 0; trial < 20; ++trial) {
-    std::vector<cv::Mat> moved;
-    for (const auto& gc : g) {  // a move of a real filter: the DFT of a random real signal
-      cv::Mat d(gc.size(), CV_32F), df;
-      rng.fill(d, cv::RNG::NORMAL, 0, 1e-2);
-      cv::dft(d, df, cv::DFT_COMPLEX_OUTPUT);
-      moved.push_back(gc + df);
-    }
-    EXPECT_GT(joint_objective(samples, a, w2, moved), best) << trial;
+  TemporalPrior prior{0.5, {}};
+  for (int c = 0; c < 3; ++c) {
+    cv::Mat r(6, 8, CV_32F), rf;
+    cv::RNG(20 + c).fill(r, cv::RNG::NORMAL, 0, 0.2);
+    cv::dft(r, rf, cv::DFT_COMPLEX_OUTPUT);
+    prior.reference.push_back(rf);
   }
+  for (const TemporalPrior& p : {TemporalPrior{}, prior}) {
+    std::vector<cv::Mat> g;
+    train_joint_filter(samples, a, w2, 2, g, p);
+    const double early = joint_objective(samples, a, w2, g, p);
+    EXPECT_LT(train_joint_filter(samples, a, w2, 300, g, p), 1e-4);
+    const double best = joint_objective(samples, a, w2, g, p);
+    EXPECT_LE(best, early);
+    cv::RNG rng(3);
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<cv::Mat> moved;
+      for (const auto& gc : g) {  // a move of a real filter: the DFT of a random real signal
+        cv::Mat d(gc.size(), CV_32F), df;
+        rng.fill(d, cv::RNG::NORMAL, 0, 1e-2);
+        cv::dft(d, df, cv::DFT_COMPLEX_OUTPUT);
+        moved.push_back(gc + df);
+      }
+      EXPECT_GT(joint_objective(samples, a, w2, moved, p), best) << p.theta << " " << trial;
+    }
+  }
+}
+
+// AutoTrack's variation by hand on a 5 x 5 grid, the target 3 x 3 cells around the centre (2, 2):
+// Pi = |R_t - R_t-1|, its RMS over the 9 target cells; log(1 + Pi) x delta added to w there only;
+// theta0 / (1 + log(1 + nu ||Pi||)).
+TEST(SpatioTemporal, ResponseVariationAndRegularisersByHand) {
+  cv::Mat before(5, 5, CV_32F, cv::Scalar(0)), now;
+  before.at<float>(2, 2) = 1;
+  now = before.clone();
+  now.at<float>(2, 3) = 0.5f;  // inside the target
+  now.at<float>(1, 1) = 0.3f;  // inside
+  now.at<float>(0, 4) = 0.9f;  // outside
+  const ResponseVariation v = response_variation(before, now, {3, 3});
+  EXPECT_FLOAT_EQ(v.local.at<float>(2, 3), 0.5f);
+  EXPECT_FLOAT_EQ(v.local.at<float>(0, 4), 0.9f);
+  EXPECT_FLOAT_EQ(v.local.at<float>(2, 2), 0.f);
+  EXPECT_NEAR(v.global, std::sqrt((0.25 + 0.09) / 9), 1e-7);
+  EXPECT_EQ(response_variation(now, now, {3, 3}).global, 0.0);
+
+  const cv::Mat w2(5, 5, CV_32F, cv::Scalar(0.04));  // w = 0.2
+  const cv::Mat varied = varied_regulariser(w2, v, {3, 3}, 0.5);
+  EXPECT_NEAR(varied.at<float>(2, 3), std::pow(0.2 + 0.5 * std::log(1.5), 2), 1e-6);
+  EXPECT_NEAR(varied.at<float>(1, 1), std::pow(0.2 + 0.5 * std::log(1.3), 2), 1e-6);
+  EXPECT_NEAR(varied.at<float>(2, 2), 0.04, 1e-7);  // no change
+  EXPECT_NEAR(varied.at<float>(0, 4), 0.04, 1e-7);  // changed, but outside the target
+  EXPECT_DOUBLE_EQ(temporal_weight(2, 3, 0), 2);
+  EXPECT_NEAR(temporal_weight(2, 3, 1), 2 / (1 + std::log(4.0)), 1e-12);
+
+  EXPECT_THROW(response_variation(before, cv::Mat(4, 5, CV_32F, cv::Scalar(0)), {3, 3}), std::invalid_argument);
+  EXPECT_THROW(response_variation(before, now, {0, 3}), std::invalid_argument);
+  EXPECT_THROW(varied_regulariser(cv::Mat(4, 4, CV_32F, cv::Scalar(1)), v, {3, 3}, 0.5), std::invalid_argument);
 }
 
 // ECO's Gauss-Newton learns a projection that fits the label better than the PCA it starts
@@ -336,21 +413,42 @@ TEST(JointFilter, GaussNewtonLearnsABetterProjection) {
 }
 
 // The tracker with the joint filter: a moving target followed to within a few pixels.
+// The joint filter holds a moving target, alone and with AutoTrack's regularisation. With a
+// response-change limit of 1e-9 every frame after the first is a failure that teaches the filter
+// nothing: the track is exactly that of a filter never retrained (update_interval beyond the
+// sequence), and differs from the learning one's.
 TEST(Eco, JointFilterTracksAMovingTarget) {
   const Scene scene({240, 180}, {40, 32});
-  EcoParams p;
-  p.joint_filter = true;
-  EcoTracker t(p);
-  Motion m;
-  m.centre = {90, 80};
-  t.init(scene.render(m), scene.box(m));
-  for (int i = 1; i <= 30; ++i) {
-    m.centre = {90 + 1.5 * i, 80 + 0.5 * i};
-    const TrackState s = t.update(scene.render(m));
-    ASSERT_NEAR(s.pose.x, m.centre.x, 3) << i;
-    ASSERT_NEAR(s.pose.y, m.centre.y, 3) << i;
-    EXPECT_FALSE(s.lost) << i;
-  }
+  auto track = [&](const EcoParams& p) {
+    EcoTracker t(p);
+    Motion m;
+    m.centre = {90, 80};
+    t.init(scene.render(m), scene.box(m));
+    std::vector<cv::Point2d> poses;
+    for (int i = 1; i <= 30; ++i) {
+      m.centre = {90 + 1.5 * i, 80 + 0.5 * i};
+      const TrackState s = t.update(scene.render(m));
+      EXPECT_NEAR(s.pose.x, m.centre.x, 3) << p.temporal_reg << " " << p.variation_limit << " " << i;
+      EXPECT_NEAR(s.pose.y, m.centre.y, 3) << p.temporal_reg << " " << p.variation_limit << " " << i;
+      EXPECT_FALSE(s.lost) << i;
+      poses.emplace_back(s.pose.x, s.pose.y);
+    }
+    return poses;
+  };
+  EcoParams joint;
+  joint.joint_filter = true;
+  track(joint);
+  EcoParams autotrack = joint;
+  autotrack.temporal_reg = 1;
+  autotrack.variation_gain = 10;
+  autotrack.variation_reg = 0.3;
+  const auto learning = track(autotrack);
+  EcoParams frozen = autotrack, untrained = autotrack;
+  frozen.variation_limit = 1e-9;
+  untrained.update_interval = 1000;
+  const auto gated = track(frozen);
+  EXPECT_EQ(gated, track(untrained));
+  EXPECT_NE(gated, learning);
 }
 
 namespace {
@@ -476,6 +574,10 @@ TEST(Eco, SameInputSameTrack) {
   joint.joint_filter = true;
   joint.projection_steps = 3;
   EXPECT_EQ(exit_track(e, joint, 50), exit_track(e, joint, 50));
+  joint.temporal_reg = 1;  // and AutoTrack's regularisation
+  joint.variation_reg = 0.3;
+  joint.variation_limit = 0.5;
+  EXPECT_EQ(exit_track(e, joint, 50), exit_track(e, joint, 50));
 }
 
 TEST(Eco, BadParametersAreNamed) {
@@ -499,6 +601,10 @@ TEST(Eco, BadParametersAreNamed) {
   EXPECT_NE(message([](EcoParams& p) { p.reg_floor = NAN; }).find("reg_floor"), std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.cg_iterations = 0; }).find("cg_iterations"), std::string::npos);
   EXPECT_NE(message([](EcoParams& p) { p.projection_reg = -1; }).find("projection_reg"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.temporal_reg = -1; }).find("temporal_reg"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.variation_gain = INFINITY; }).find("variation_gain"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.variation_reg = NAN; }).find("variation_reg"), std::string::npos);
+  EXPECT_NE(message([](EcoParams& p) { p.variation_limit = -0.5; }).find("variation_limit"), std::string::npos);
   EXPECT_EQ(message([](EcoParams&) {}), "accepted");
 }
 
