@@ -193,8 +193,7 @@ void EcoTracker::train() {
     cv::Mat w2 = regulariser_;
     TemporalPrior prior;
     if (frames_ > 0 && p_.variation_reg > 0 && !variation_.local.empty())
-      w2 = varied_regulariser(regulariser_ / energy_, variation_, target_in_model() * (1.0 / p_.cell), p_.variation_reg) *
-           energy_;
+      w2 = varied_regulariser(regulariser_, variation_, target_cells(), p_.variation_reg * std::sqrt(energy_));  // w x sqrt(energy)
     if (frames_ > 0 && p_.temporal_reg > 0) {
       prior.theta = temporal_weight(p_.temporal_reg, p_.variation_gain, variation_.global) * energy_;
       for (const auto& g : filter_) prior.reference.push_back(g.clone());  // the filter moves in place
@@ -259,7 +258,7 @@ void EcoTracker::init(const cv::Mat& frame, const cv::Rect2d& box) {
   variation_ = {};
   if (p_.joint_filter) {  // SRDCF's regulariser, relative to this first sample's energy
     energy_ = std::max(mean_energy({first}, {1.0}), 1e-30);
-    regulariser_ = spatial_regulariser(fw_.cells, target_in_model() * (1.0 / p_.cell), p_.reg_floor, p_.reg_edge) * energy_;
+    regulariser_ = spatial_regulariser(fw_.cells, target_cells(), p_.reg_floor, p_.reg_edge) * energy_;
   }
   if (p_.joint_filter && p_.projection_steps > 0) {
     // ECO's Gauss-Newton from the PCA: the projections learned with the filter on this window.
@@ -391,7 +390,7 @@ TrackState EcoTracker::update(const cv::Mat& frame) {
   if (p_.joint_filter && spatio_temporal()) {
     const cv::Mat centred = centred_response(d, shift);
     variation_ = last_response_.empty() ? ResponseVariation{}
-                                        : response_variation(last_response_, centred, target_in_model() * (1.0 / p_.cell));
+                                        : response_variation(last_response_, centred, target_cells());
     last_response_ = centred;
     abnormal = p_.variation_limit > 0 && variation_.global > p_.variation_limit;
   }

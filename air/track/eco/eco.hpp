@@ -176,6 +176,7 @@ class EcoTracker : public Tracker {
   cv::Mat centred_response(const Detection& d, cv::Point2d shift_cells) const;
   bool spatio_temporal() const { return p_.temporal_reg > 0 || p_.variation_reg > 0 || p_.variation_limit > 0; }
   cv::Size2d target_in_model() const { return target_ * (fw_.model.width / fw_.window.width); }
+  cv::Size2d target_cells() const { return target_in_model() * (1.0 / p_.cell); }
   void train();
   // The verifier's patch of the box centred `offset` image pixels from the centre of a window
   // patch (a detection's, already resized to the model: cheap whatever the target's size).
