@@ -3,6 +3,7 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(LCM REQUIRED IMPORTED_TARGET lcm)           # LCM 1.3.1 has no CMake package
 find_program(LCM_GEN lcm-gen REQUIRED)
 pkg_check_modules(HWY REQUIRED IMPORTED_TARGET libhwy)         # portable SIMD (SSE4/AVX2/NEON)
+pkg_check_modules(SODIUM REQUIRED IMPORTED_TARGET libsodium)   # AEAD, KDF, SHA-256 (link sealing, MAVLink signing)
 
 find_package(Threads REQUIRED)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)

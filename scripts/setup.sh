@@ -9,7 +9,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libeigen3-dev libceres-dev
   liboctomap-dev libdynamicedt3d-dev octomap-tools
   libvtk9-dev mpi-default-dev xvfb xauth
-  libyaml-cpp-dev libcli11-dev libspdlog-dev libfuzzylite-dev libnlopt-cxx-dev libhwy-dev
+  libyaml-cpp-dev libcli11-dev libspdlog-dev libfuzzylite-dev libnlopt-cxx-dev libhwy-dev libsodium-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   iproute2 python3-numpy python3-matplotlib
 )
