@@ -6,6 +6,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "common/geometry/frames.hpp"
+
 namespace aerie::pilot {
 
 namespace {
@@ -61,12 +63,7 @@ Pilot::Pilot(PilotConfig config) : cfg_(std::move(config)) {
   left_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.left);
   up_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.up);
   yaw_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.yaw);
-  // Camera optical axes in the body frame: x right (-y_body), z tilted down by the pitch.
-  const double p = cfg_.camera_pitch_deg * kDeg;
-  const Eigen::Vector3d x_c(0, -1, 0), z_c(std::cos(p), 0, -std::sin(p));
-  R_body_cam_.col(0) = x_c;
-  R_body_cam_.col(1) = z_c.cross(x_c);
-  R_body_cam_.col(2) = z_c;
+  R_body_cam_ = geometry::body_from_camera(cfg_.camera_pitch_deg);
   status_.state = State::Idle;
 }
 
