@@ -28,6 +28,7 @@ inline constexpr const char* kSimState = "SIM_STATE";    // aerie.sim_state_t (s
 inline constexpr const char* kFlcParams = "FLC_PARAMS";  // aerie.flc_params_t
 inline constexpr const char* kCeProgress = "CE_PROGRESS";  // aerie.ce_progress_t
 inline constexpr const char* kLinkStats = "LINK_STATS";  // aerie.link_stats_t
+inline constexpr const char* kAutopilotState = "AUTOPILOT_STATE";  // aerie.autopilot_state_t (aerie-mavlink)
 inline constexpr const char* kStatusPrefix = "STATUS_";  // aerie.process_status_t, STATUS_<NODE>
 
 }  // namespace aerie::channels
