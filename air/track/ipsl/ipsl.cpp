@@ -20,14 +20,21 @@ void require(bool ok, const std::string& what, const std::string& field, double 
   if (!ok) throw std::invalid_argument(what + ": " + field + " = " + std::to_string(value) + " is out of range");
 }
 
+// A count in [lo, hi] (the documented range, docs/track_ipsl.md).
+void require_in(int value, int lo, int hi, const std::string& what, const std::string& field) {
+  if (value < lo || value > hi)
+    throw std::invalid_argument(what + ": " + field + " = " + std::to_string(value) + " is outside [" +
+                                std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
 void validate_common(const std::string& what, const MotionSigma& s, const AppearanceParams& a,
                      const RecoveryParams& r) {
   for (auto [name, v] : {std::pair{"sigma.x", s.x}, {"sigma.y", s.y}, {"sigma.scale", s.scale},
                          {"sigma.theta", s.theta}})
     require(std::isfinite(v) && v >= 0, what, name, v);
   require(a.patch_size >= 4 && a.patch_size <= 256, what, "patch_size", a.patch_size);
-  require(a.max_basis >= 1, what, "max_basis", a.max_basis);
-  require(a.block_size >= 1, what, "block_size", a.block_size);
+  require_in(a.max_basis, 1, kMaxBasis, what, "max_basis");
+  require_in(a.block_size, 1, kMaxBlockSize, what, "block_size");
   require(std::isfinite(a.forgetting) && a.forgetting > 0 && a.forgetting <= 1, what, "forgetting", a.forgetting);
   const auto& l = a.likelihood;
   require(std::isfinite(l.robust_scale) && l.robust_scale > 0, what, "robust_scale", l.robust_scale);
@@ -42,7 +49,7 @@ void validate_common(const std::string& what, const MotionSigma& s, const Appear
   require(std::isfinite(r.typical_rate) && r.typical_rate > 0 && r.typical_rate <= 1, what, "typical_rate",
           r.typical_rate);
   require(std::isfinite(r.growth) && r.growth >= 1, what, "recovery_growth", r.growth);
-  require(r.max_lost_frames >= 0, what, "max_lost_frames", r.max_lost_frames);
+  require_in(r.max_lost_frames, 0, kMaxLostFrames, what, "max_lost_frames");
   require(std::isfinite(r.max_factor) && r.max_factor >= 1, what, "recovery_max_factor", r.max_factor);
 }
 
@@ -73,28 +80,40 @@ void read_common(const util::Config& c, MotionSigma& s, AppearanceParams& a, Rec
 
 std::string config_name(const util::Config& c, const char* tracker) { return tracker + (" (" + c.origin() + ")"); }
 
+// particles in [1, kMaxParticles], and their observation matrix (particles x patch_size^2
+// floats) within kMaxObservationFloats; patch_size itself is checked by validate_common.
+void require_particles(const std::string& what, int particles, int patch_size) {
+  require_in(particles, 1, kMaxParticles, what, "particles");
+  const int64_t floats = int64_t{particles} * patch_size * patch_size;
+  if (patch_size >= 4 && patch_size <= 256 && floats > kMaxObservationFloats)
+    throw std::invalid_argument(what + ": particles x patch_size^2 = " + std::to_string(particles) + " x " +
+                                std::to_string(patch_size) + "^2 is larger than " +
+                                std::to_string(kMaxObservationFloats) + " observation values per frame");
+}
+
 }  // namespace
 
 void validate(const IpslParams& p) {
   const std::string what = "ipsl parameters";
-  require(p.particles >= 1, what, "particles", p.particles);
   validate_common(what, p.sigma, p.appearance, p.recovery);
+  require_particles(what, p.particles, p.appearance.patch_size);
 }
 
 void validate(const HierarchicalIpslParams& p) {
   const std::string what = "ipsl-mr parameters";
   require(std::isfinite(p.min_size) && p.min_size >= 1, what, "min_size", p.min_size);
-  require(p.max_levels >= 1 && (p.appearance.patch_size >> (p.max_levels - 1)) >= 4, what,
+  validate_common(what, p.sigma, p.appearance, p.recovery);
+  require_in(p.max_levels, 1, kMaxLevels, what, "max_levels");
+  require((p.appearance.patch_size >> (p.max_levels - 1)) >= 4, what,
           "max_levels (patch_size / 2^(max_levels-1) must be >= 4)", p.max_levels);
-  require(p.particles >= 1, what, "particles", p.particles);
+  require_particles(what, p.particles, p.appearance.patch_size);
   require(std::isfinite(p.reject_ratio) && p.reject_ratio >= 0 && p.reject_ratio < 1, what, "reject_ratio",
           p.reject_ratio);
   require(std::isfinite(p.min_range) && p.min_range >= 0, what, "min_range", p.min_range);
   require(std::isfinite(p.max_range) && p.max_range >= p.min_range, what, "max_range", p.max_range);
   require(std::isfinite(p.min_theta_factor) && p.min_theta_factor >= 0 && p.min_theta_factor <= 1, what,
           "min_theta_factor", p.min_theta_factor);
-  require(p.coarsest_block_size >= 1, what, "coarsest_block_size", p.coarsest_block_size);
-  validate_common(what, p.sigma, p.appearance, p.recovery);
+  require_in(p.coarsest_block_size, 1, kMaxBlockSize, what, "coarsest_block_size");
 }
 
 // The parameters read from `c`, validated; an error names the config section.

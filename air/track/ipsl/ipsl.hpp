@@ -111,6 +111,16 @@ struct HierarchicalIpslParams {
   RecoveryParams recovery;
 };
 
+// Upper bounds of the counts that set the work and memory of a frame, checked by validate()
+// before anything is allocated: a TRACK_CMD may override any key (docs/track_ipsl.md).
+inline constexpr int kMaxParticles = 5000;        // particles (N_P; ipsl-mr: at the coarsest level)
+inline constexpr int kMaxBasis = 256;             // max_basis (k)
+inline constexpr int kMaxBlockSize = 256;         // block_size, coarsest_block_size (N_B)
+inline constexpr int kMaxLevels = 8;              // ipsl-mr max_levels (N_PL)
+inline constexpr int kMaxLostFrames = 100000;     // max_lost_frames
+// particles x patch_size^2: the floats of one frame's observation matrix (eq. 3.1), 64 MiB.
+inline constexpr int64_t kMaxObservationFloats = int64_t{1} << 24;
+
 // Read the parameters from a config section (keys documented in docs/track_ipsl.md);
 // absent keys keep their defaults; invalid values throw std::invalid_argument naming the key.
 IpslParams ipsl_params_from_config(const util::Config& section);

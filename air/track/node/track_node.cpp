@@ -5,6 +5,8 @@
 
 #include <charconv>
 #include <chrono>
+#include <cmath>
+#include <sstream>
 
 #include "air/track/factory.hpp"
 #include "common/camera/calibration_io.hpp"
@@ -19,7 +21,7 @@ NodeOptions node_options(const util::Config& cfg) {
                   "node.init_from_gt", "target.name", "target.width_m", "target.height_m", "target.yaw_offset_deg",
                   "target.shape", "target.border", "target.search_margin", "target.reseed_iou", "target.fit_h_when_cut",
                   "camera.calibration", "camera.fx", "camera.fy", "camera.cx", "camera.cy", "camera.width", "camera.height", "trackers.*",
-                  "message_time.*"});
+                  "message_time.*", "node.max_queued_commands", "node.max_queued_bytes"});
   NodeOptions o;
   const util::Config node = cfg.section("node");
   o.camera_channel = node.get("camera_channel", o.camera_channel);
@@ -32,6 +34,8 @@ NodeOptions node_options(const util::Config& cfg) {
   o.seed = node.get<uint64_t>("seed", o.seed);
   o.max_points = node.get_in("max_points", o.max_points, 0, 100000);
   o.init_from_gt = node.get_in("init_from_gt", o.init_from_gt, -1, 1000000);
+  o.max_queued_commands = node.get_in("max_queued_commands", o.max_queued_commands, 1, 1000);
+  o.max_queued_bytes = node.get_in<int64_t>("max_queued_bytes", o.max_queued_bytes, 65536, int64_t{64} << 20);
   o.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), o.message_time);
   if (!is_known_tracker(o.tracker))
     throw std::runtime_error(cfg.origin() + ": node.tracker: unknown tracker '" + o.tracker + "'");
@@ -81,6 +85,44 @@ NodeOptions node_options(const util::Config& cfg) {
     }
   }
   return o;
+}
+
+std::string refuse_command(const aerie::track_cmd_t& c, std::string* reason) {
+  auto refuse = [&](const char* why, const std::string& message) {
+    if (reason) *reason = why;
+    return message;
+  };
+  const auto chars = [](size_t n, size_t limit) {
+    return " of " + std::to_string(n) + " characters (at most " + std::to_string(limit) + ")";
+  };
+  if (c.nparams < 0 || c.nparams > kMaxCommandParams || c.param_names.size() > size_t{kMaxCommandParams} ||
+      c.param_values.size() > size_t{kMaxCommandParams})
+    return refuse("too_large", "nparams = " + std::to_string(c.nparams) + " (at most " +
+                                   std::to_string(kMaxCommandParams) + " parameter overrides)");
+  if (c.tracker.size() > kMaxCommandName) return refuse("too_large", "tracker name" + chars(c.tracker.size(), kMaxCommandName));
+  if (c.camera.size() > kMaxCommandCamera) return refuse("too_large", "camera" + chars(c.camera.size(), kMaxCommandCamera));
+  for (size_t i = 0; i < c.param_names.size(); ++i)
+    if (c.param_names[i].size() > kMaxCommandName)
+      return refuse("too_large", "param_names[" + std::to_string(i) + "]" + chars(c.param_names[i].size(), kMaxCommandName));
+  for (size_t i = 0; i < c.param_values.size(); ++i)
+    if (c.param_values[i].size() > kMaxCommandValue)
+      return refuse("too_large", "param_values[" + std::to_string(i) + "]" +
+                                     (i < c.param_names.size() ? " ('" + c.param_names[i] + "')" : std::string()) +
+                                     chars(c.param_values[i].size(), kMaxCommandValue));
+  // The fields are bounded above, so the encoded size cannot overflow.
+  if (const int64_t bytes = c.getEncodedSize(); bytes > kMaxCommandBytes)
+    return refuse("too_large", std::to_string(bytes) + " bytes encoded (at most " + std::to_string(kMaxCommandBytes) + ")");
+  if (c.command == aerie::track_cmd_t::INIT) {
+    const std::pair<const char*, double> box[] = {{"x", c.x}, {"y", c.y}, {"width", c.width}, {"height", c.height}};
+    for (const auto& [name, v] : box)
+      if (!std::isfinite(v) || std::abs(v) > kMaxBoxCoordinate) {
+        std::ostringstream m;
+        m << "INIT box " << name << " = " << v << " is not a number of pixels in [-" << kMaxBoxCoordinate << ", "
+          << kMaxBoxCoordinate << "]";
+        return refuse("bad_box", m.str());
+      }
+  }
+  return {};
 }
 
 namespace {
@@ -186,10 +228,33 @@ void TrackNode::on_frame(Frame frame) {
 }
 
 void TrackNode::on_command(const aerie::track_cmd_t& cmd) {
-  std::lock_guard lk(mutex_);
-  ++counters_["commands"];
-  commands_.push_back(cmd);
+  count("commands");
+  std::string reason;
+  if (const std::string why = refuse_command(cmd, &reason); !why.empty()) {
+    count("commands_refused." + reason);
+    fail(opt_.command_channel + " seq " + std::to_string(cmd.seq) + ": " + why + ": refused");
+    return;
+  }
+  // Bounded: the newest commands win; the oldest beyond max_queued_commands / _bytes are dropped.
+  const int64_t bytes = cmd.getEncodedSize();
+  int64_t dropped = 0;
+  {
+    std::lock_guard lk(mutex_);
+    while (!commands_.empty() && (commands_.size() >= static_cast<size_t>(opt_.max_queued_commands) ||
+                                  command_bytes_ + bytes > opt_.max_queued_bytes)) {
+      command_bytes_ -= commands_.front().getEncodedSize();
+      commands_.pop_front();
+      ++dropped;
+    }
+    commands_.push_back(cmd);
+    command_bytes_ += bytes;
+    if (dropped > 0) counters_["commands_dropped.queue_full"] += dropped;
+  }
   wake_.notify_one();
+  if (dropped > 0)
+    fail(opt_.command_channel + ": " + std::to_string(dropped) + " older command(s) dropped: more than " +
+         std::to_string(opt_.max_queued_commands) + " commands or " + std::to_string(opt_.max_queued_bytes) +
+         " bytes waiting for the tracker");
 }
 
 void TrackNode::on_gt(const aerie::gt_box_t& gt) {
@@ -256,6 +321,7 @@ void TrackNode::run() {
       wake_.wait(lk, [&] { return stop_ || pending_ || !commands_.empty(); });
       if (stop_) return;
       cmds.swap(commands_);
+      command_bytes_ = 0;
       frame.swap(pending_);
       busy_ = true;
     }
@@ -281,14 +347,22 @@ void TrackNode::run() {
         frame.reset();
       }
     }
-    if (!last_frame_.empty()) {  // INIT commands that came before the first frame
-      cmds.insert(cmds.begin(), deferred_.begin(), deferred_.end());
-      deferred_.clear();
+    if (!last_frame_.empty() && deferred_) {  // the INIT that came before the first frame
+      cmds.push_front(*deferred_);
+      deferred_.reset();
     }
     for (const auto& cmd : cmds) {
       try {
+        // Before the first frame one INIT is held: a later INIT or a STOP supersedes it.
+        if (last_frame_.empty() && deferred_ &&
+            (cmd.command == aerie::track_cmd_t::INIT || cmd.command == aerie::track_cmd_t::STOP)) {
+          count("commands_dropped.superseded");
+          spdlog::info("{}: INIT seq {} held for the first frame is superseded by {} seq {}", opt_.command_channel,
+                       deferred_->seq, cmd.command == aerie::track_cmd_t::INIT ? "INIT" : "STOP", cmd.seq);
+          deferred_.reset();
+        }
         if (cmd.command == aerie::track_cmd_t::INIT && last_frame_.empty()) {
-          deferred_.push_back(cmd);
+          deferred_ = cmd;
           continue;
         }
         execute(cmd);

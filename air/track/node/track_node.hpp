@@ -68,7 +68,26 @@ struct NodeOptions {
   // jumps is held (never tracked, so a bogus time never reaches TRACK / TARGET_POSE), a restart or
   // outage re-synchronises, no frame for stale_timeout_s is reported as "<camera> stale".
   util::MessageClockConfig message_time;
+  // TRACK_CMD bounds (docs/track.md, TRACK_CMD "Bounds"): at most this many commands and encoded bytes
+  // wait for the worker (node.max_queued_commands [1, 1000], node.max_queued_bytes
+  // [65536, 67108864]); beyond, the oldest are dropped (commands_dropped.queue_full).
+  int max_queued_commands = 32;
+  int64_t max_queued_bytes = int64_t{1} << 20;
 };
+
+// Limits of one TRACK_CMD, checked when it arrives (before it is queued): a command beyond
+// them is refused (commands_refused.<reason>) and never held. An INIT's box is in pixels of
+// an image (at most image::kMaxPixels, 4096 x 4096): no coordinate needs more than 65536.
+inline constexpr int kMaxCommandParams = 64;          // nparams
+inline constexpr size_t kMaxCommandName = 64;         // tracker and each parameter name, characters
+inline constexpr size_t kMaxCommandValue = 1024;      // each parameter value (YAML text), characters
+inline constexpr size_t kMaxCommandCamera = 256;      // camera channel name, characters
+inline constexpr int64_t kMaxCommandBytes = 65536;    // the whole encoded command
+inline constexpr double kMaxBoxCoordinate = 65536;    // |x|, |y|, width, height of an INIT box, pixels
+
+// Why a TRACK_CMD is refused on arrival ("" = acceptable): the counter's reason (too_large,
+// bad_box) in `reason` and a message naming the field and its limit.
+std::string refuse_command(const aerie::track_cmd_t& cmd, std::string* reason);
 
 // Reads the "node", "target", "camera" and "trackers" sections of track.yaml; throws naming
 // the file and key on a bad value.
@@ -116,7 +135,8 @@ class TrackNode {
   mutable std::mutex mutex_;
   std::condition_variable wake_, idle_, taken_;  // taken_: the worker took the pending frame
   std::optional<Frame> pending_;
-  std::deque<aerie::track_cmd_t> commands_;
+  std::deque<aerie::track_cmd_t> commands_;  // bounded: max_queued_commands, max_queued_bytes
+  int64_t command_bytes_ = 0;                // encoded bytes in commands_
   std::map<std::string, int64_t> counters_;
   std::string error_;
   bool error_fresh_ = false;
@@ -128,7 +148,8 @@ class TrackNode {
   std::string stale_message_;
 
   // Worker state.
-  std::deque<aerie::track_cmd_t> deferred_;  // INIT commands waiting for the first frame
+  // The INIT waiting for the first frame: only the newest (a later INIT or a STOP supersedes it).
+  std::optional<aerie::track_cmd_t> deferred_;
   std::unique_ptr<Tracker> tracker_;
   std::string tracker_name_;
   util::Config tracker_params_;

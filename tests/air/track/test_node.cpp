@@ -11,7 +11,10 @@
 #include "tests/support/test_support.hpp"
 
 #include <opencv2/imgproc.hpp>
+#include <cmath>
 #include <limits>
+#include <map>
+#include <string>
 #include <tuple>
 
 using namespace aerie::track;
@@ -458,4 +461,171 @@ TEST_F(NodeTest, TheDefaultTrackerIsEco) {
   ASSERT_FALSE(tracks_.empty());
   EXPECT_EQ(tracks_.back().tracker, "eco");
   EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+}
+
+// Issue 46: 8 MB TRACK_CMD INITs queued before the first frame grew the tracker from 55 to
+// 157 MB. Before the first frame only the newest INIT waits; the others are superseded.
+TEST_F(NodeTest, OnlyTheNewestInitWaitsForTheFirstFrame) {
+  TrackNode node(bus_, NodeOptions{});
+  const int kInits = 40;
+  for (int i = 0; i < kInits; ++i) {
+    send_init(cv::Rect2d(20 + i, 30, 40, 32), "amcmr-ct");
+    while (bus_.handle(0) > 0) {
+    }
+  }
+  settle(node);
+  EXPECT_EQ(node.counter("commands"), kInits);
+  // Superseded by the worker, or dropped from its queue when it had not run yet: one is left.
+  EXPECT_EQ(node.counter("commands_dropped.superseded") + node.counter("commands_dropped.queue_full"), kInits - 1);
+  EXPECT_GE(node.counter("commands_dropped.superseded"), 1);
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  ASSERT_EQ(tracks_.size(), 1u);
+  EXPECT_EQ(tracks_[0].status, aerie::track_t::TRACKING);
+  EXPECT_DOUBLE_EQ(tracks_[0].x, 20 + (kInits - 1) + 20.0);  // the centre of the last INIT's box
+  EXPECT_DOUBLE_EQ(tracks_[0].y, 30 + 16.0);
+  EXPECT_EQ(node.counter("command_errors"), 0);
+}
+
+TEST_F(NodeTest, AStopBeforeTheFirstFrameCancelsTheWaitingInit) {
+  TrackNode node(bus_, NodeOptions{});
+  send_init(scene_.box(motion(0)), "amcmr-ct");
+  settle(node);
+  aerie::track_cmd_t stop{};
+  stop.command = aerie::track_cmd_t::STOP;
+  bus_.publish("TRACK_CMD", stop);
+  settle(node);
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  ASSERT_EQ(tracks_.size(), 1u);
+  EXPECT_EQ(tracks_[0].status, aerie::track_t::IDLE);  // the INIT was superseded by the STOP
+  EXPECT_EQ(node.counter("commands_dropped.superseded"), 1);
+  EXPECT_EQ(node.counter("command_errors"), 0);
+}
+
+TEST_F(NodeTest, OversizedCommandsAreRefusedOnArrivalNamingTheField) {
+  TrackNode node(bus_, NodeOptions{});
+  aerie::bus::StatusReporter status(bus_, "track");
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  const cv::Rect2d box = scene_.box(motion(0));
+  auto init = [&] {
+    aerie::track_cmd_t c{};
+    c.command = aerie::track_cmd_t::INIT;
+    c.tracker = "amcmr-ct";
+    c.x = box.x, c.y = box.y, c.width = box.width, c.height = box.height;
+    return c;
+  };
+  auto with_params = [&](int n, size_t value_size) {
+    aerie::track_cmd_t c = init();
+    c.nparams = n;
+    for (int i = 0; i < n; ++i) {
+      c.param_names.push_back("p" + std::to_string(i));
+      c.param_values.push_back(std::string(value_size, '1'));
+    }
+    return c;
+  };
+  struct Case {
+    aerie::track_cmd_t cmd;
+    std::string reason, message;
+  };
+  std::vector<Case> cases;
+  {
+    aerie::track_cmd_t c = init();
+    c.nparams = 1;
+    c.param_names = {"search_radius"};
+    c.param_values = {std::string(size_t{8} << 20, '1')};  // the issue's 8 MB INIT
+    cases.push_back({c, "too_large", "param_values[0] ('search_radius') of 8388608 characters (at most 1024)"});
+  }
+  cases.push_back({with_params(1000, 1), "too_large", "nparams = 1000 (at most 64 parameter overrides)"});
+  {
+    aerie::track_cmd_t c = init();
+    c.tracker = std::string(100, 'x');
+    cases.push_back({c, "too_large", "tracker name of 100 characters (at most 64)"});
+  }
+  {
+    aerie::track_cmd_t c = init();
+    c.camera = std::string(300, 'C');
+    cases.push_back({c, "too_large", "camera of 300 characters (at most 256)"});
+  }
+  cases.push_back({with_params(64, 1024), "too_large", "bytes encoded (at most 65536)"});
+  {
+    aerie::track_cmd_t c = init();
+    c.width = std::nan("");
+    cases.push_back({c, "bad_box", "INIT box width = nan is not a number of pixels in [-65536, 65536]"});
+  }
+  {
+    aerie::track_cmd_t c = init();
+    c.x = 1e300;
+    cases.push_back({c, "bad_box", "INIT box x = 1e+300 is not a number of pixels"});
+  }
+  std::map<std::string, int64_t> expected;
+  for (const auto& c : cases) {
+    bus_.publish("TRACK_CMD", c.cmd);
+    settle(node);
+    node.report(status);
+    EXPECT_NE(status.message().find(c.message), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("refused"), std::string::npos) << status.message();
+    EXPECT_EQ(node.counter("commands_refused." + c.reason), ++expected[c.reason]) << c.message;
+  }
+  EXPECT_EQ(node.counter("commands"), static_cast<int64_t>(cases.size()));
+  EXPECT_EQ(node.counter("command_errors"), 0);  // refused on arrival: none reached the tracker
+  bus_.publish("CAM_LEFT", frame(1));
+  settle(node);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::IDLE);
+  // A command at the limits is accepted and tracks.
+  aerie::track_cmd_t ok = init();
+  ok.nparams = 1;
+  ok.param_names = {"search_radius"};
+  ok.param_values = {"16" + std::string(kMaxCommandValue - 2, ' ')};  // YAML: trailing spaces
+  bus_.publish("TRACK_CMD", ok);
+  settle(node);
+  bus_.publish("CAM_LEFT", frame(2));
+  settle(node);
+  EXPECT_EQ(node.counter("command_errors"), 0);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  EXPECT_EQ(tracks_.back().tracker, "amcmr-ct");
+}
+
+TEST(NodeOptions, CommandQueueBoundsAreReadAndRanged) {
+  const NodeOptions o = node_options(aerie::util::Config::parse("node: {max_queued_commands: 5, max_queued_bytes: 131072}\n", "t.yaml"));
+  EXPECT_EQ(o.max_queued_commands, 5);
+  EXPECT_EQ(o.max_queued_bytes, 131072);
+  EXPECT_EQ(NodeOptions{}.max_queued_commands, 32);
+  EXPECT_THROW(node_options(aerie::util::Config::parse("node: {max_queued_commands: 0}\n", "t.yaml")), std::runtime_error);
+  EXPECT_THROW(node_options(aerie::util::Config::parse("node: {max_queued_bytes: 1000000000}\n", "t.yaml")), std::runtime_error);
+}
+
+// IPSL's counts had no upper bound (particles, ipsl.cpp): a TRACK_CMD override beyond the
+// documented range is refused and the current track goes on.
+TEST_F(NodeTest, IpslCountsOverriddenByACommandAreBounded) {
+  if (!is_known_tracker("ipsl")) GTEST_SKIP() << "ipsl is not built";
+  TrackNode node(bus_, NodeOptions{});
+  aerie::bus::StatusReporter status(bus_, "track");
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  send_init(scene_.box(motion(0)), "amcmr-ct");
+  bus_.publish("CAM_LEFT", frame(1));
+  settle(node);
+  for (const auto& [tracker, name, value, message] :
+       std::vector<std::tuple<std::string, std::string, std::string, std::string>>{
+           {"ipsl", "particles", "6000", "particles = 6000 is outside [1, 5000]"},
+           {"ipsl-mr", "max_levels", "100", "max_levels = 100 is outside [1, 8]"},
+           {"ipsl", "block_size", "100000", "block_size = 100000 is outside [1, 256]"}}) {
+    aerie::track_cmd_t c{};
+    c.command = aerie::track_cmd_t::SET_TRACKER;
+    c.tracker = tracker;
+    c.nparams = 1;
+    c.param_names = {name};
+    c.param_values = {value};
+    bus_.publish("TRACK_CMD", c);
+    settle(node);
+    node.report(status);
+    EXPECT_NE(status.message().find(message), std::string::npos) << status.message();
+  }
+  EXPECT_EQ(node.counter("command_errors"), 3);
+  bus_.publish("CAM_LEFT", frame(2));
+  settle(node);
+  EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
+  EXPECT_EQ(tracks_.back().tracker, "amcmr-ct");
 }

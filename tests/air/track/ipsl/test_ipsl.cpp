@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
 #include <opencv2/imgproc.hpp>
 
 #include "air/track/ipsl/ipsl.hpp"
@@ -333,4 +336,42 @@ bad:
     EXPECT_NE(std::string(e.what()).find("forgetting"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("test.yaml"), std::string::npos) << e.what();
   }
+}
+
+// Every count a TRACK_CMD can override is bounded before anything is allocated: particles had
+// no upper bound, and max_levels beyond 31 shifted patch_size by more than its width.
+TEST(Ipsl, CountsAreBoundedToTheirDocumentedRanges) {
+  auto refusal = [](const std::string& section, const std::string& yaml) -> std::string {
+    const auto cfg = aerie::util::Config::parse(section + ": " + yaml + "\n", "cmd.yaml");
+    try {
+      if (section == "ipsl")
+        ipsl_params_from_config(cfg.section(section));
+      else
+        hierarchical_ipsl_params_from_config(cfg.section(section));
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {"ipsl", "{particles: 5001}", "particles = 5001 is outside [1, 5000]"},
+      {"ipsl", "{particles: 2000000000}", "particles = 2000000000 is outside [1, 5000]"},
+      {"ipsl", "{particles: 0}", "particles = 0 is outside [1, 5000]"},
+      {"ipsl", "{max_basis: 257}", "max_basis = 257 is outside [1, 256]"},
+      {"ipsl", "{block_size: 1000}", "block_size = 1000 is outside [1, 256]"},
+      {"ipsl", "{max_lost_frames: 100001}", "max_lost_frames = 100001 is outside [0, 100000]"},
+      {"ipsl", "{particles: 5000, patch_size: 64}", "particles x patch_size^2 = 5000 x 64^2 is larger than 16777216"},
+      {"ipsl_mr", "{particles: 5001}", "particles = 5001 is outside [1, 5000]"},
+      {"ipsl_mr", "{max_levels: 33}", "max_levels = 33 is outside [1, 8]"},
+      {"ipsl_mr", "{coarsest_block_size: 257}", "coarsest_block_size = 257 is outside [1, 256]"},
+  };
+  for (const auto& [section, yaml, message] : cases) {
+    const std::string what = refusal(section, yaml);
+    EXPECT_NE(what.find(message), std::string::npos) << section << " " << yaml << ": " << what;
+    EXPECT_NE(what.find("cmd.yaml"), std::string::npos) << what;
+  }
+  // The limits themselves are accepted.
+  EXPECT_EQ(refusal("ipsl", "{particles: 5000, max_basis: 256, block_size: 256, max_lost_frames: 100000}"), "accepted");
+  EXPECT_EQ(refusal("ipsl", "{particles: 4096, patch_size: 64}"), "accepted");  // exactly 2^24 values
+  EXPECT_EQ(refusal("ipsl_mr", "{particles: 5000, max_levels: 3, coarsest_block_size: 256}"), "accepted");
 }
