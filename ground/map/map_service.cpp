@@ -48,7 +48,8 @@ MapServiceConfig MapServiceConfig::from_config(const util::Config& cfg) {
                   "visibility_if_occluded", "distance_map.max_distance", "distance_map.max_cells", "publish.period_s",
                   "publish.full_every", "publish.binary", "matching.pose_tolerance_us", "matching.pose_wait_us",
                   "matching.pose_buffer", "message_time.*", "channels.pose", "channels.depth",
-                  "channels.octomap", "channels.query", "channels.response", "channels.cmd", "files.directory"});
+                  "channels.octomap", "channels.query", "channels.response", "channels.cmd", "files.directory",
+                  "files.max_files", "files.max_bytes"});
   MapServiceConfig c;
   auto& o = c.occupancy;
   // Ranges as documented in config/map.yaml; the probabilities are checked by validate().
@@ -89,6 +90,8 @@ MapServiceConfig MapServiceConfig::from_config(const util::Config& cfg) {
   c.response_channel = cfg.get("channels.response", c.response_channel);
   c.cmd_channel = cfg.get("channels.cmd", c.cmd_channel);
   c.files_directory = cfg.get("files.directory", c.files_directory);
+  c.max_files = cfg.get_in("files.max_files", c.max_files, 1, 100000);
+  c.max_bytes = cfg.get_in<int64_t>("files.max_bytes", c.max_bytes, int64_t{1} << 20, int64_t{1} << 40);
   return c;
 }
 
@@ -385,20 +388,30 @@ void MapService::on_query(const aerie::map_query_t& q, const bus::ReceiveInfo&) 
 
 std::filesystem::path MapService::confined(const std::string& name) const {
   if (config_.files_directory.empty())
-    throw std::invalid_argument("SAVE and LOAD over " + config_.cmd_channel + " are off (files.directory is not set)");
-  const bool plain = !name.empty() && name.size() <= 64 && name[0] != '.' &&
+    throw FileRefused("off", "SAVE and LOAD over " + config_.cmd_channel + " are off (files.directory is not set)");
+  const bool plain = !name.empty() && name.size() <= 64 && name[0] != '.' && name.find("..") == std::string::npos &&
                      std::all_of(name.begin(), name.end(), [](char ch) {
                        return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.';
                      });
   const std::string ext = std::filesystem::path(name).extension().string();
-  if (!plain || (ext != ".bt" && ext != ".ot"))
-    throw std::invalid_argument("'" + name.substr(0, 80) + "' is not a plain map file name in " + config_.files_directory +
-                                " (letters, digits, '_', '-', '.', at most 64, not starting with '.', ending .bt or .ot)");
+  if (!plain || (ext != ".bt" && ext != ".ot")) {
+    std::string shown;  // at most 80 characters of it, control characters as '?' (it goes to the log)
+    for (const char ch : name.substr(0, 80)) shown += std::isprint(static_cast<unsigned char>(ch)) ? ch : '?';
+    throw FileRefused("bad_name", "'" + shown + "' is not a plain map file name in " + config_.files_directory +
+                                      " (letters, digits, '_', '-', '.', at most 64, not starting with '.', no " +
+                                      "\"..\", ending .bt or .ot)");
+  }
   return std::filesystem::path(config_.files_directory) / name;
 }
 
-std::string MapService::save_in_directory(const std::string& name) const {
+std::string MapService::save_in_directory(const std::string& name) {
   const std::filesystem::path first = confined(name);
+  if (files_saved_ >= config_.max_files)
+    throw FileRefused("max_files", "SAVE refused: " + std::to_string(files_saved_) + " map files written in this run (files.max_files = " +
+                                       std::to_string(config_.max_files) + ")");
+  if (bytes_saved_ >= config_.max_bytes)
+    throw FileRefused("max_bytes", "SAVE refused: " + std::to_string(bytes_saved_) + " bytes of maps written in this run (files.max_bytes = " +
+                                       std::to_string(config_.max_bytes) + ")");
   std::filesystem::create_directories(config_.files_directory);
   const std::string stem = first.stem().string(), ext = first.extension().string();
   for (int version = 0; version <= 1000; ++version) {
@@ -406,7 +419,20 @@ std::string MapService::save_in_directory(const std::string& name) const {
         version == 0 ? first : first.parent_path() / (stem + "-" + std::to_string(version) + ext);
     std::error_code ec;
     if (std::filesystem::exists(std::filesystem::symlink_status(p, ec))) continue;  // never overwritten
-    if (map_.save_new(p.string())) return p.string();  // false: taken meanwhile, try the next version
+    if (!map_.save_new(p.string())) continue;  // taken meanwhile, try the next version
+    const auto size = std::filesystem::file_size(p, ec);
+    const int64_t bytes = ec ? 0 : static_cast<int64_t>(size);
+    if (bytes_saved_ + bytes > config_.max_bytes) {  // its size is known once written: taken back
+      std::filesystem::remove(p, ec);
+      throw FileRefused("max_bytes", "SAVE refused: the map's " + std::to_string(bytes) + " bytes would pass files.max_bytes = " +
+                                         std::to_string(config_.max_bytes) + " (" + std::to_string(bytes_saved_) +
+                                         " written in this run)");
+    }
+    ++files_saved_;
+    bytes_saved_ += bytes;
+    status_.set("files_saved", files_saved_);
+    status_.set("bytes_saved", bytes_saved_);
+    return p.string();
   }
   throw std::runtime_error("map: 1000 versions of '" + name + "' exist in " + config_.files_directory);
 }
@@ -415,8 +441,8 @@ void MapService::load_from_directory(const std::string& name) {
   const std::filesystem::path p = confined(name);
   std::error_code ec;
   if (std::filesystem::is_symlink(std::filesystem::symlink_status(p, ec)))
-    throw std::invalid_argument("'" + p.string() + "' is a symbolic link; LOAD reads only files in " +
-                                config_.files_directory);
+    throw FileRefused("symlink", "'" + p.string() + "' is a symbolic link; LOAD reads only files in " +
+                                     config_.files_directory);
   load(p.string());
 }
 
@@ -459,6 +485,9 @@ void MapService::on_cmd(const aerie::map_cmd_t& c, const bus::ReceiveInfo&) {
         throw std::invalid_argument("unknown command " + std::to_string(c.command));
     }
     status_.count("commands_done");
+  } catch (const FileRefused& e) {  // counted with its reason, and among the command errors
+    status_.count(std::string(c.command == aerie::map_cmd_t::SAVE ? "save_refused." : "load_refused.") + e.reason());
+    reject("command_errors", config_.cmd_channel + " seq " + std::to_string(c.seq) + ": " + e.what());
   } catch (const std::exception& e) {
     reject("command_errors", config_.cmd_channel + " seq " + std::to_string(c.seq) + ": " + e.what());
   }

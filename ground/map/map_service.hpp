@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "common/bus/bus.hpp"
@@ -50,9 +51,24 @@ struct MapServiceConfig {
   // plain file name in it (no '/', no "..", not hidden, .bt or .ot, at most 64 characters)
   // and LOAD refuses a symlink. "" = SAVE and LOAD over LCM are refused.
   std::string files_directory;
+  // files.max_files / files.max_bytes: what MAP_CMD SAVE may write in one run of the node (files,
+  // and bytes of map files); a SAVE beyond is refused (save_refused.max_files / .max_bytes).
+  int max_files = 100;
+  int64_t max_bytes = int64_t{1} << 30;
 
   // Reads config/map.yaml keys (see the file); missing keys keep their defaults.
   static MapServiceConfig from_config(const util::Config& cfg);
+};
+
+// A MAP_CMD SAVE or LOAD refused by the file rules; reason() is the counter's suffix
+// (save_refused.<reason>, load_refused.<reason>): off, bad_name, symlink, max_files, max_bytes.
+class FileRefused : public std::invalid_argument {
+ public:
+  FileRefused(std::string reason, const std::string& what) : std::invalid_argument(what), reason_(std::move(reason)) {}
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string reason_;
 };
 
 // MAP_QUERY replies go to channels.response, or to channels.response + "_" + a suffix of
@@ -76,8 +92,12 @@ class MapService {
   // Replaces the map with a checked one from a file (read_octree_file); the old map stays on failure.
   void load(const std::string& path);
   // MAP_CMD SAVE: a new file in files.directory, never an existing one: `name` when it is
-  // free, else `<stem>-1<ext>`, `<stem>-2<ext>`, ... Returns the path written.
-  std::string save_in_directory(const std::string& name) const;
+  // free, else `<stem>-1<ext>`, `<stem>-2<ext>`, ... Returns the path written. Throws
+  // FileRefused beyond files.max_files / files.max_bytes of this run (a file that would pass
+  // max_bytes is removed again).
+  std::string save_in_directory(const std::string& name);
+  int files_saved() const { return files_saved_; }
+  int64_t bytes_saved() const { return bytes_saved_; }
   // MAP_CMD LOAD: `name` in files.directory.
   void load_from_directory(const std::string& name);
 
@@ -99,7 +119,7 @@ class MapService {
   void expire_pending();
   void maybe_publish(int64_t utime);
   aerie::map_response_t answer(const aerie::map_query_t& q);
-  // files.directory / name, after checking name; throws std::invalid_argument.
+  // files.directory / name, after checking name; throws FileRefused (off, bad_name).
   std::filesystem::path confined(const std::string& name) const;
   void reject(const std::string& counter, const std::string& message);
 
@@ -119,6 +139,8 @@ class MapService {
   std::optional<Region> unpublished_;              // changed since the last publication
   int64_t publish_seq_ = 0;
   int publications_ = 0;
+  int files_saved_ = 0;      // by MAP_CMD SAVE in this run
+  int64_t bytes_saved_ = 0;
 };
 
 }  // namespace aerie::map

@@ -553,3 +553,81 @@ TEST(MapService, ConfigRefusesUnknownKeysAndValuesOutsideTheirRanges) {
   aerie::test::expect_refusals(load, cases);
   EXPECT_EQ(aerie::test::refusal(load, "publish:\n  period_s: 0\n"), "");  // 0 = never publish
 }
+
+// Issue 46: 400 MAP_CMD SAVEs wrote 400 files. SAVE writes at most files.max_files files and
+// files.max_bytes bytes per run; the refusals are counted with their reason.
+TEST(MapService, SaveIsBoundedInFilesAndBytesPerRun) {
+  const auto dir = aerie::test::scratch_dir("save_bounds");
+  m::MapServiceConfig cfg;
+  cfg.files_directory = dir.string();
+  ASSERT_EQ(cfg.max_files, 100);  // the default
+  Harness h(cfg);
+  map_room(h);
+  for (int i = 0; i < 400; ++i) command(h, aerie::map_cmd_t::SAVE, "room.ot");
+  const auto files = [&] {
+    return std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator());
+  };
+  EXPECT_EQ(files(), 100);
+  EXPECT_TRUE(std::filesystem::exists(dir / "room-99.ot"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "room-100.ot"));
+  EXPECT_EQ(h.counter("save_refused.max_files"), 300);
+  EXPECT_EQ(h.counter("command_errors"), 300);
+  EXPECT_EQ(h.counter("files_saved"), 100);
+  EXPECT_EQ(h.service.files_saved(), 100);
+  EXPECT_NE(h.status.message().find("100 map files written in this run (files.max_files = 100)"), std::string::npos)
+      << h.status.message();
+  const int64_t one = static_cast<int64_t>(std::filesystem::file_size(dir / "room.ot"));
+  EXPECT_EQ(h.counter("bytes_saved"), 100 * one);
+
+  // Bytes: room for one map and a half; the second save is taken back and refused.
+  const auto dir2 = aerie::test::scratch_dir("save_bytes");
+  cfg.files_directory = dir2.string();
+  cfg.max_bytes = one + one / 2;
+  Harness b(cfg);
+  map_room(b);
+  command(b, aerie::map_cmd_t::SAVE, "room.ot");
+  ASSERT_TRUE(std::filesystem::exists(dir2 / "room.ot"));
+  command(b, aerie::map_cmd_t::SAVE, "room.ot");
+  EXPECT_FALSE(std::filesystem::exists(dir2 / "room-1.ot"));
+  EXPECT_EQ(b.counter("save_refused.max_bytes"), 1);
+  EXPECT_NE(b.status.message().find("would pass files.max_bytes = " + std::to_string(one + one / 2)), std::string::npos)
+      << b.status.message();
+  EXPECT_EQ(b.service.bytes_saved(), one);
+  // A bad name is refused by its own reason, before any quota; LOAD keeps working.
+  for (const std::string& bad : std::vector<std::string>{"a..ot", "../room.ot", std::string(200, 'x') + ".ot", "room\n.ot"})
+    command(b, aerie::map_cmd_t::SAVE, bad);
+  EXPECT_EQ(b.counter("save_refused.bad_name"), 4);
+  EXPECT_EQ(b.status.message().find('\n'), std::string::npos) << "control characters are not logged";
+  command(b, aerie::map_cmd_t::LOAD, "a..ot");
+  EXPECT_EQ(b.counter("load_refused.bad_name"), 1);
+  const int64_t errors = b.counter("command_errors");
+  command(b, aerie::map_cmd_t::LOAD, "room.ot");
+  EXPECT_EQ(b.counter("command_errors"), errors);
+  EXPECT_EQ(b.counter("commands_done"), 2);  // the first SAVE and the LOAD
+  EXPECT_EQ(b.query(aerie::map_query_t::OCCUPANCY, kInside).occupancy, aerie::map_response_t::FREE);
+
+  // Without files.directory: counted as off.
+  Harness off;
+  command(off, aerie::map_cmd_t::SAVE, "room.ot");
+  command(off, aerie::map_cmd_t::LOAD, "room.ot");
+  EXPECT_EQ(off.counter("save_refused.off"), 1);
+  EXPECT_EQ(off.counter("load_refused.off"), 1);
+}
+
+TEST(MapService, SaveBoundsAreConfigKeysWithRanges) {
+  const auto shipped = m::MapServiceConfig::from_config(
+      aerie::util::Config::load((aerie::test::source_dir() / "config" / "map.yaml").string()));
+  EXPECT_EQ(shipped.max_files, 100);
+  EXPECT_EQ(shipped.max_bytes, int64_t{1} << 30);
+  const auto cfg = m::MapServiceConfig::from_config(
+      aerie::util::Config::parse("files:\n  max_files: 7\n  max_bytes: 2000000\n", "map.yaml"));
+  EXPECT_EQ(cfg.max_files, 7);
+  EXPECT_EQ(cfg.max_bytes, 2000000);
+  const auto load = [](const std::string& text) {
+    m::MapServiceConfig::from_config(aerie::util::Config::parse(text, "map.yaml"));
+  };
+  aerie::test::expect_refusals(load, std::vector<std::pair<std::string, std::string>>{
+                                         {"files:\n  max_files: 0\n", "'files.max_files' = 0 is outside its valid range [1, 100000]"},
+                                         {"files:\n  max_bytes: 10\n", "'files.max_bytes' = 10 is outside"},
+                                     });
+}
