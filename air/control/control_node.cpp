@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "air/control/anchor_file.hpp"
 #include "common/bus/channels.hpp"
@@ -10,6 +11,52 @@
 #include "common/util/time.hpp"
 
 namespace aerie::control {
+
+namespace {
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+}  // namespace
+
+void check_incoming_controller(const flc::FlcSpec& spec, const std::string& origin) {
+  struct Factor {
+    const flc::Variable& v;
+    const char* role;
+    const char* gain;
+    double lo;
+    bool lo_open, sign_free;
+  };
+  const Factor factors[] = {{spec.inputs[0], "input", "Kp", kMinGain, false, false},
+                            {spec.inputs[1], "input", "Kd", 0.0, true, false},
+                            {spec.inputs[2], "input", "Ki", 0.0, true, true},
+                            {spec.output, "output", "Ku", kMinGain, false, false}};
+  for (const auto& f : factors) {
+    const double k = f.sign_free ? std::abs(f.v.scaling) : f.v.scaling;
+    const bool ok = std::isfinite(k) && (f.lo_open ? k > f.lo : k >= f.lo) && k <= kMaxScaling;
+    if (ok) continue;
+    const std::string range = f.sign_free ? "|" + std::string(f.gain) + "| in (0, " + number(kMaxScaling) + "]"
+                                          : std::string(f.lo_open ? "(" : "[") + number(f.lo) + ", " + number(kMaxScaling) + "]";
+    throw std::invalid_argument(origin + ": " + f.gain + " (scaling of " + f.role + " '" + f.v.name + "') = " +
+                                number(f.v.scaling) + " is outside " + range +
+                                (f.v.scaling < 0 && !f.sign_free ? ": a negative factor reverses the command" : ""));
+  }
+  const flc::Variable& out = spec.output;
+  if (!(out.min < 0 && out.max > 0) || out.min < -kMaxOutputRange || out.max > kMaxOutputRange)
+    throw std::invalid_argument(origin + ": output '" + out.name + "' range [" + number(out.min) + ", " + number(out.max) +
+                                "] must hold 0 inside and lie within [-" + number(kMaxOutputRange) + ", " +
+                                number(kMaxOutputRange) + "] deg/s");
+  const flc::Flc flc(spec);
+  for (const double e : {10.0, 45.0, 90.0}) {
+    const double right = flc.evaluate(e, 0, 0), left = flc.evaluate(-e, 0, 0);
+    const bool strict = e == 90.0;
+    if (!(strict ? right > 0 : right >= 0) || !(strict ? left < 0 : left <= 0))
+      throw std::invalid_argument(origin + ": rules: a heading error of +/-" + number(e) + " deg alone gives " +
+                                  number(right) + " / " + number(left) + " deg/s: the controller does not turn " +
+                                  "toward the reference (positive error, positive yaw rate)");
+  }
+}
 
 flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::FlcSpec& current) {
   const std::string origin = "FLC_PARAMS '" + m.controller_id + "'";
@@ -35,6 +82,7 @@ flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::Fl
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(origin + ": " + e.what());
   }
+  check_incoming_controller(spec, origin);
   return spec;
 }
 

@@ -42,8 +42,25 @@ std::string default_pose_channel(NodeOptions::Input input);
 // How each input's orientation becomes a heading by default (config/control.yaml, heading_frame).
 HeadingFrame default_heading_frame(NodeOptions::Input input);
 
+// Ranges of a controller received on FLC_PARAMS (docs/control.md "FLC_PARAMS"), beyond
+// FlcSpec::validate() (finite positions, strictly increasing, inside their variable's range):
+// Kp and Ku in [kMinGain, kMaxScaling], Kd in (0, kMaxScaling] — a negative factor reverses the
+// loop (an FLC_PARAMS with Ku = -50 inverted the yaw command, issue 46); Ki non-zero in
+// [-kMaxScaling, kMaxScaling]: the rule base's integral acts with a negative Ki (docs/flc.md,
+// thesis CE: Ki = -0.5003). The output range holds 0 inside and is within +/-kMaxOutputRange
+// deg/s (the largest limits.max_yaw_rate_deg_s).
+inline constexpr double kMinGain = 0.01;
+inline constexpr double kMaxScaling = 100.0;
+inline constexpr double kMaxOutputRange = 720.0;
+// Throws std::invalid_argument naming the field (prefixed by `origin`) when `spec` is outside
+// the ranges above, or when it does not turn toward the reference: a heading error of
+// +/-10, 45, 90 deg alone (derivative and integral 0) must not give an output of the other
+// sign, and +/-90 deg must give one of its sign.
+void check_incoming_controller(const flc::FlcSpec& spec, const std::string& origin);
+
 // The controller a FLC_PARAMS message describes: its FLL if it has one, else the
-// current controller; then its named parameters; its id. Throws with the reason.
+// current controller; then its named parameters; its id; checked by FlcSpec::validate() and
+// check_incoming_controller(). Throws with the reason.
 flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::FlcSpec& current);
 
 class ControlNode {

@@ -695,3 +695,86 @@ TEST(ControlNode, ARestartedControlResumesTheManoeuvreFromItsAnchorFile) {
   drain(none.bus);
   EXPECT_NE(none.status.message().find("no anchor_file is configured"), std::string::npos) << none.status.message();
 }
+
+// Issue 46: an FLC_PARAMS controller with Ku = -50 was accepted and inverted the yaw command.
+// Scaling factors, output range and the turn's sign are checked; a refused controller is
+// counted, its reason names the field, and the old one keeps flying.
+TEST(ControlNode, ControllersOutsideTheirRangesAreRefusedAndTheOldOneKeepsFlying) {
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "control");
+  ControlNode node(bus, status, tuned(), NodeOptions{});
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  bus.publish("VO_POSE", vo_pose(1'000'000, 0.0));
+  drain(bus);
+  auto params = [](const std::string& id, const std::string& name, double value) {
+    aerie::flc_params_t m{};
+    m.controller_id = id;
+    m.nparams = 1;
+    m.names = {name};
+    m.values = {value};
+    return m;
+  };
+  auto with_fll = [](const std::string& id, const flc::FlcSpec& spec) {
+    aerie::flc_params_t m{};
+    m.controller_id = id;
+    m.fll = flc::to_fll(spec);
+    return m;
+  };
+  flc::FlcSpec inverted = tuned();  // every rule's output mirrored: turns away from the reference
+  for (auto& r : inverted.rules) r.out = inverted.output.size() - 1 - r.out;
+  flc::FlcSpec wide = tuned();
+  wide.output.min = -5000;
+  wide.output.max = 5000;
+  const std::vector<std::pair<aerie::flc_params_t, std::string>> cases{
+      {params("ku-50", "Ku", -50),
+       "Ku (scaling of output 'yaw_rate') = -50 is outside [0.01, 100]: a negative factor reverses the command"},
+      {params("kp-neg", "Kp", -3), "Kp (scaling of input 'error') = -3 is outside [0.01, 100]"},
+      {params("kp-huge", "error.scaling", 1e6), "Kp (scaling of input 'error') = 1e+06 is outside [0.01, 100]"},
+      {params("kp-tiny", "Kp", 1e-9), "Kp (scaling of input 'error') = 1e-09 is outside [0.01, 100]"},
+      {params("kd-neg", "Kd", -0.01), "Kd (scaling of input 'derivative') = -0.01 is outside (0, 100]"},
+      {params("ki-huge", "Ki", -500), "Ki (scaling of input 'integral') = -500 is outside |Ki| in (0, 100]"},
+      {params("ku-huge", "Ku", 1e9), "Ku (scaling of output 'yaw_rate') = 1e+09 is outside [0.01, 100]"},
+      {params("unordered", "error.Left", 10), "set 'Zero' position 0 must be greater than 'Left' (10)"},
+      {params("nan", "Kp", std::nan("")), "parameter 'Kp' is not finite"},
+      {with_fll("wide", wide), "output 'yaw_rate' range [-5000, 5000] must hold 0 inside and lie within [-720, 720] deg/s"},
+      {with_fll("inverted", inverted), "does not turn toward the reference"},
+  };
+  int64_t refused = 0;
+  for (const auto& [m, why] : cases) {
+    bus.publish("FLC_PARAMS", m);
+    drain(bus);
+    EXPECT_EQ(status.counter("params_refused"), ++refused) << m.controller_id;
+    EXPECT_NE(status.message().find(why), std::string::npos) << m.controller_id << ": " << status.message();
+    EXPECT_NE(status.message().find("refused controller '" + m.controller_id + "'"), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("(keeping 'tuned')"), std::string::npos) << status.message();
+    EXPECT_EQ(node.loop().controller().id, "tuned");
+    EXPECT_DOUBLE_EQ(node.loop().controller().parameter("Ku"), 1.0);
+  }
+  EXPECT_EQ(status.counter("params_accepted"), 0);
+  // The old controller still turns right toward the reference 90 deg to the right.
+  node.publish_command(util::wall_utime());
+  drain(bus);
+  ASSERT_EQ(cmds.size(), 1u);
+  EXPECT_EQ(cmds[0].mode, aerie::control_cmd_t::ACTIVE);
+  EXPECT_GT(cmds[0].yaw_rate_deg_s, 10.0f);
+  EXPECT_EQ(cmds[0].controller_id, "tuned");
+  // Inside the ranges (Ki negative, as CE finds it) a controller is taken.
+  bus.publish("FLC_PARAMS", params("ki-neg", "Ki", -0.5));
+  drain(bus);
+  EXPECT_EQ(status.counter("params_accepted"), 1);
+  EXPECT_EQ(node.loop().controller().id, "ki-neg");
+}
+
+TEST(ControlNode, TheShippedControllersPassTheIncomingChecks) {
+  for (const char* file : {"initial.yaml", "sf.yaml", "sfmf.yaml"}) {
+    const flc::FlcSpec spec = flc::load_controller((test::source_dir() / "config" / "flc" / file).string());
+    EXPECT_NO_THROW(check_incoming_controller(spec, file)) << file;
+    // and as ceopt sends them: FLL
+    aerie::flc_params_t m{};
+    m.controller_id = file;
+    m.fll = flc::to_fll(spec);
+    EXPECT_NO_THROW(controller_from_message(m, tuned())) << file;
+  }
+  EXPECT_NO_THROW(check_incoming_controller(flc::thesis_initial(), "initial"));
+}
