@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace aerie::pilot {
 
@@ -56,9 +57,28 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
     });
   }, 1000);  // 200 Hz: a deep queue so that a burst is not dropped
   bus_.subscribe<aerie::pilot_cmd_t>(opt_.operator_channel, [this](const aerie::pilot_cmd_t& m, const bus::ReceiveInfo&) {
-    if (m.command < aerie::pilot_cmd_t::START || m.command > aerie::pilot_cmd_t::RESUME) {
+    // `source` is whatever the sender wrote: nothing authenticates it yet (issue 46), so the log
+    // says so, and shows it quoted, at most 64 characters, control characters escaped.
+    std::string source;
+    for (const char ch : m.source.substr(0, 64)) {
+      const auto c = static_cast<unsigned char>(ch);
+      if (c == '"' || c == '\\') source += '\\';
+      if (c >= 0x20 && c < 0x7f) {
+        source += ch;
+      } else {
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "\\x%02x", c);
+        source += hex;
+      }
+    }
+    if (m.source.size() > 64) source += "...";
+    static const char* const kNames[] = {"START", "ABORT", "LAND", "RESUME"};
+    const bool known = m.command >= aerie::pilot_cmd_t::START && m.command <= aerie::pilot_cmd_t::RESUME;
+    const std::string what = opt_.operator_channel + " " + (known ? kNames[m.command] : std::to_string(m.command)) +
+                             " (source \"" + source + "\", unauthenticated)";
+    if (!known) {
       count("operator_refused");
-      last_error_ = opt_.operator_channel + ": unknown command " + std::to_string(m.command);
+      last_error_ = what + ": unknown command";
       spdlog::warn("{}", last_error_);
       return;
     }
@@ -67,11 +87,10 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
     std::string why;
     if (pilot_.on_operator(static_cast<Pilot::Operator>(m.command), utime, &why)) {
       count("operator_accepted");
-      spdlog::info("operator command from '{}' accepted: {} ({})", m.source, state_name(pilot_.state()),
-                   pilot_.status().reason);
+      spdlog::info("{} accepted: {} ({})", what, state_name(pilot_.state()), pilot_.status().reason);
     } else {
       count("operator_refused");
-      last_error_ = opt_.operator_channel + ": " + why;
+      last_error_ = what + " refused: " + why;
       spdlog::warn("{}", last_error_);
     }
   });

@@ -6,8 +6,13 @@
 #include <aerie/target_pose_t.hpp>
 #include <aerie/track_t.hpp>
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "air/pilot/node/pilot_node.hpp"
@@ -140,4 +145,62 @@ TEST(PilotNode, AgesEachTrackOnItsOwnClockWhenTheClocksAreComparable) {
   p.drain();
   EXPECT_EQ(node.pilot().status().aged_results, 3);
   EXPECT_EQ(cmds.size(), 7u);  // every TRACK answered, aged or not (lock-step)
+}
+
+namespace {
+// The default logger's output in a string while it lives.
+struct CapturedLog {
+  std::ostringstream text;
+  std::shared_ptr<spdlog::logger> previous = spdlog::default_logger();
+  CapturedLog() {
+    auto logger = std::make_shared<spdlog::logger>("capture", std::make_shared<spdlog::sinks::ostream_sink_mt>(text));
+    logger->set_pattern("%l %v");
+    logger->set_level(spdlog::level::info);
+    spdlog::set_default_logger(logger);
+  }
+  ~CapturedLog() { spdlog::set_default_logger(previous); }
+};
+}  // namespace
+
+// Issue 46: the pilot logged PILOT_CMD's `source`, which the sender chooses, as if it named the
+// operator. Until commands come through the sealed link, the log says it is unauthenticated,
+// and a source cannot forge log lines.
+TEST(PilotNode, OperatorCommandsAreLoggedWithAnUnauthenticatedSource) {
+  CapturedLog log;
+  {
+    PilotOnBus p;
+    aerie::track_t t{};  // the first TRACK starts the mission (TAKEOFF): ABORT then applies
+    t.status = aerie::track_t::IDLE;
+    t.utime = 50000;
+    p.bus.publish("TRACK", t);
+    p.drain();
+    aerie::pilot_cmd_t op{};
+    op.command = aerie::pilot_cmd_t::ABORT;
+    op.source = "x";
+    p.bus.publish("PILOT_CMD", op);
+    op.command = aerie::pilot_cmd_t::LAND;
+    op.source = "ground\ninfo PILOT_CMD ABORT (source \"operator\") ok";
+    p.bus.publish("PILOT_CMD", op);
+    op.command = 9;
+    op.source = std::string(100, 'y');
+    p.bus.publish("PILOT_CMD", op);
+    p.drain();
+    EXPECT_GE(p.node.counter("operator_accepted"), 1);  // the ABORT (and the LAND, which applies after it)
+    EXPECT_EQ(p.node.counter("operator_accepted") + p.node.counter("operator_refused"), 3);
+  }
+  const std::string text = log.text.str();
+  EXPECT_NE(text.find("info PILOT_CMD ABORT (source \"x\", unauthenticated) accepted: "), std::string::npos) << text;
+  EXPECT_NE(text.find("PILOT_CMD LAND (source \"ground\\x0ainfo PILOT_CMD ABORT (source \\\"operator\\\") ok\", "
+                      "unauthenticated) "),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("warning PILOT_CMD 9 (source \"" + std::string(64, 'y') + "...\", unauthenticated): unknown command"),
+            std::string::npos)
+      << text;
+  // One line per command: the newline in the forged source did not start a line of its own.
+  int lines = 0;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines += line.find("unauthenticated)") != std::string::npos;
+  EXPECT_EQ(lines, 3) << text;
+  EXPECT_EQ(text.find("\ninfo PILOT_CMD ABORT (source \"operator\""), std::string::npos) << text;
 }
