@@ -18,7 +18,7 @@ usage() {
   cat <<EOF
 Options:
   --link              relay through aerie-link between an air and a ground network
-  --link-config FILE  aerie-link configuration (default: config/link.yaml)
+  --link-config FILE  aerie-link configuration (default: config/link.yaml; the demo adds PMD_* to its channels)
   --config FILE       procman config (default: config/split.pmd)
   --duration S        seconds to fly between start_all and stop_all (default: 20)
   --log FILE          flight log written on the ground (default: logs/split.lcm)
@@ -100,8 +100,14 @@ if [[ $LINK -eq 1 ]]; then
   AIR_URL="udpm://239.255.76.67:7667?ttl=0"
   GROUND_URL="udpm://239.255.76.68:7668?ttl=1"
   ip -n "$AIR" route add 239.255.76.67/32 dev lo
-  echo "split-demo: aerie-link ($LINK_CONFIG) on the air host between $AIR_URL and $GROUND_URL"
-  ip netns exec "$AIR" "$BIN/aerie-link" --config "$LINK_CONFIG" --air-url "$AIR_URL" --ground-url "$GROUND_URL" \
+  # The link's config lets no procman channel cross by default; this demo runs the air deputy
+  # from the ground sheriff, so a copy names them explicitly (docs/link.md "Channels").
+  awk '/^air_to_ground:/ { dir = "down" } /^ground_to_air:/ { dir = "up" }
+       /^  channels: "/ { sub(/"$/, dir == "down" ? "|PMD_INFO2|PMD_PRINTF|PMD_DISCOVER\"" : "|PMD_ORDERS2|PMD_DISCOVER\"") }
+       { print }' "$LINK_CONFIG" >"$RUN_DIR/link.yaml"
+  grep -q 'PMD_ORDERS2' "$RUN_DIR/link.yaml" || die "$LINK_CONFIG: no ground_to_air.channels line to add PMD_* to"
+  echo "split-demo: aerie-link ($LINK_CONFIG, with PMD_* named) on the air host between $AIR_URL and $GROUND_URL"
+  ip netns exec "$AIR" "$BIN/aerie-link" --config "$RUN_DIR/link.yaml" --air-url "$AIR_URL" --ground-url "$GROUND_URL" \
     >"$RUN_DIR/link.log" 2>&1 &
   LINK_PID=$!
   PIDS+=($LINK_PID)

@@ -4,8 +4,11 @@
 // (ttl=1 across the veth) or through aerie-link between two networks. The
 // recorded log must hold the air node's images and both deputies' reports.
 #include <aerie/image_t.hpp>
+#include <aerie/link_stats_t.hpp>
+#include <aerie/pilot_cmd_t.hpp>
 #include <bot_procman/info2_t.hpp>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <sstream>
 #include <lcm/lcm-cpp.hpp>
@@ -17,6 +20,8 @@
 #include <set>
 #include <thread>
 
+#include "common/bus/bus.hpp"
+#include "common/util/time.hpp"
 #include "procman/testbed.hpp"
 #include "tests/support/test_support.hpp"
 
@@ -60,6 +65,19 @@ LogSummary read_log(const std::string& path) {
     }
   }
   return s;
+}
+
+// The shipped link config lets no procman channel cross (issue 46); a deployment whose
+// sheriff runs the air deputy through the link names them, as docs/link.md "Channels" says.
+std::string shipped_link_with_procman(const std::filesystem::path& dir) {
+  YAML::Node cfg = YAML::LoadFile((aerie::test::source_dir() / "config/link.yaml").string());
+  cfg["air_to_ground"]["channels"] = cfg["air_to_ground"]["channels"].as<std::string>() + "|PMD_INFO2|PMD_PRINTF|PMD_DISCOVER";
+  cfg["ground_to_air"]["channels"] = cfg["ground_to_air"]["channels"].as<std::string>() + "|PMD_ORDERS2|PMD_DISCOVER";
+  YAML::Emitter out;
+  out << cfg;
+  const auto path = dir / "link_with_procman.yaml";
+  std::ofstream(path) << out.c_str() << "\n";
+  return path.string();
 }
 
 double median(std::vector<double> v) {
@@ -163,10 +181,10 @@ TEST_F(Split, ThroughTheLinkEmulator) {
   const std::string air_url = "udpm://239.255.76.67:7667?ttl=0";
   const std::string ground_url = "udpm://239.255.76.68:7668?ttl=1";
   testbed::run({"ip", "-n", air_->name(), "route", "add", "239.255.76.67/32", "dev", "lo"});
-  // The shipped link config (JPEG re-encoding of CAM_*, PMD_* both ways) with a fixed
-  // 15 ms delay and no loss, so that the test is exact.
+  // The shipped link config (JPEG re-encoding of CAM_*) with PMD_* named both ways and a
+  // fixed 15 ms delay and no loss, so that the test is exact.
   auto& link = start(*air_,
-                     {bin("aerie-link"), "--config", (aerie::test::source_dir() / "config/link.yaml").string(),
+                     {bin("aerie-link"), "--config", shipped_link_with_procman(dir_),
                       "--air-url", air_url, "--ground-url", ground_url, "--delay-ms", "15", "--jitter-ms", "0",
                       "--loss", "0", "--bandwidth-kbps", "0"},
                      "link.log");
@@ -182,4 +200,69 @@ TEST_F(Split, ThroughTheLinkEmulator) {
   const double m = median(s.latency_ms);
   EXPECT_GE(m, 15.0);  // the link's delay is in every image's latency
   EXPECT_LT(m, 100.0) << "15 ms of link delay + JPEG re-encoding; generous for a loaded 2-core machine";
+}
+
+// Issue 46: the shipped link did not carry PILOT_CMD up, so in the split deployment the
+// operator's ABORT never reached the drone; and it relayed procman's orders by default.
+// Through config/link.yaml as shipped: a ground-side PILOT_CMD ABORT reaches the air bus,
+// PMD_ORDERS2 does not.
+TEST_F(Split, AnAbortFromTheGroundReachesTheAirThroughTheShippedLinkAndProcmanOrdersDoNot) {
+  const std::string air_url = "udpm://239.255.76.67:7667?ttl=0";
+  const std::string ground_url = "udpm://239.255.76.68:7668?ttl=1";
+  testbed::run({"ip", "-n", air_->name(), "route", "add", "239.255.76.67/32", "dev", "lo"});
+  // The channels as shipped; only the impairments are fixed (no loss) so that the test is exact.
+  auto& link = start(*air_,
+                     {bin("aerie-link"), "--config", (aerie::test::source_dir() / "config/link.yaml").string(),
+                      "--air-url", air_url, "--ground-url", ground_url, "--delay-ms", "15", "--jitter-ms", "0",
+                      "--loss", "0", "--bandwidth-kbps", "0"},
+                     "link.log");
+  // The drone's bus (air host) and the ground station's (ground host): LCM opens its sockets
+  // in the namespace of the thread that creates the bus and subscribes.
+  std::vector<aerie::pilot_cmd_t> on_air;
+  std::vector<std::string> procman_on_air;
+  std::unique_ptr<aerie::bus::Bus> air, ground;
+  {
+    testbed::EnterNamespace inside(*air_);
+    air = std::make_unique<aerie::bus::Bus>(air_url);
+    air->subscribe<aerie::pilot_cmd_t>("PILOT_CMD", [&](const aerie::pilot_cmd_t& m, const aerie::bus::ReceiveInfo&) {
+      on_air.push_back(m);
+    });
+    air->subscribe_raw("PMD_.*", [&](const uint8_t*, size_t, const aerie::bus::ReceiveInfo& i) {
+      procman_on_air.push_back(i.channel);
+    });
+  }
+  bool link_up = false;
+  {
+    testbed::EnterNamespace inside(*ground_);
+    ground = std::make_unique<aerie::bus::Bus>(ground_url);
+    ground->subscribe<aerie::link_stats_t>("LINK_STATS", [&](const auto&, const auto&) { link_up = true; });
+  }
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (!link_up && link.running() && std::chrono::steady_clock::now() < until) ground->handle(50);
+  ASSERT_TRUE(link_up) << "aerie-link did not start: " << link.log();
+
+  aerie::pilot_cmd_t abort{};
+  abort.command = aerie::pilot_cmd_t::ABORT;
+  abort.source = "operator";
+  const uint8_t orders[16] = {};  // what crosses is decided by channel, not by content
+  const auto give_up = std::chrono::steady_clock::now() + 10s;
+  while (on_air.empty() && std::chrono::steady_clock::now() < give_up) {
+    abort.utime = aerie::util::wall_utime();
+    ++abort.seq;
+    {
+      testbed::EnterNamespace inside(*ground_);
+      ground->publish("PILOT_CMD", abort);
+      ground->publish_raw("PMD_ORDERS2", orders, sizeof(orders));
+    }
+    for (int i = 0; i < 10 && on_air.empty(); ++i) air->handle(20);
+  }
+  ASSERT_FALSE(on_air.empty()) << "PILOT_CMD did not cross the shipped link: " << link.log();
+  EXPECT_EQ(on_air[0].command, aerie::pilot_cmd_t::ABORT);
+  EXPECT_EQ(on_air[0].source, "operator");
+  EXPECT_GE(on_air[0].seq, 1);
+  EXPECT_LE(on_air[0].seq, abort.seq);
+  // Well past the link's 15 ms: nothing of procman came.
+  const auto settle = std::chrono::steady_clock::now() + 500ms;
+  while (std::chrono::steady_clock::now() < settle) air->handle(20);
+  EXPECT_TRUE(procman_on_air.empty()) << procman_on_air.size() << " PMD_* messages crossed, e.g. " << procman_on_air.front();
 }

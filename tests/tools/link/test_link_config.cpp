@@ -2,6 +2,7 @@
 
 #include "tests/support/test_support.hpp"
 #include "tools/link/link_config.hpp"
+#include "tools/link/relay.hpp"
 
 using namespace aerie::link;
 
@@ -73,6 +74,14 @@ TEST(LinkConfig, ErrorsNameTheFileAndKey) {
 TEST(LinkConfig, ShippedConfigLoads) {
   const auto cfg = load_link_config(aerie::util::Config::load((aerie::test::source_dir() / "config/link.yaml").string()));
   EXPECT_NE(cfg.air_url, cfg.ground_url);
-  EXPECT_NE(cfg.air_to_ground.channels.find("PMD_INFO2"), std::string::npos);
-  EXPECT_NE(cfg.ground_to_air.channels.find("PMD_ORDERS2"), std::string::npos);
+  // Issue 46: the operator's safety commands cross up by default; no procman channel crosses
+  // either way unless named (docs/link.md "Channels").
+  ChannelMatcher up(cfg.ground_to_air.channels), down(cfg.air_to_ground.channels);
+  for (const char* c : {"PILOT_CMD", "TRACK_CMD", "FLC_PARAMS", "MAP_RESPONSE"}) EXPECT_TRUE(up(c)) << c;
+  for (const char* c : {"CAM_LEFT", "TRACK", "TARGET_POSE", "VO_POSE", "STATUS_TRACK", "MAP_QUERY"}) EXPECT_TRUE(down(c)) << c;
+  for (const char* c : {"PMD_ORDERS2", "PMD_INFO2", "PMD_PRINTF", "PMD_DISCOVER", "PMD_ORDERS", "PMD_INFO"}) {
+    EXPECT_FALSE(up(c)) << c;
+    EXPECT_FALSE(down(c)) << c;
+  }
+  EXPECT_FALSE(down("PILOT_CMD"));  // commands go up only
 }
