@@ -89,17 +89,13 @@ AutopilotLink::AutopilotLink(BridgeConfig config)
       body_from_camera_(geometry::body_from_camera(cfg_.camera_pitch_deg)) {
 }
 
-namespace {
-// 10 µs signing ticks of a microsecond time: Unix time since 2015-01-01, or (simulation time,
-// which starts near 0) the time itself.
 uint64_t signing_ticks(int64_t now_us) {
   const int64_t since_2015 = now_us - static_cast<int64_t>(mav::kSigningEpochUnixSeconds) * 1'000'000;
   return static_cast<uint64_t>(std::max<int64_t>(0, since_2015 >= 0 ? since_2015 : now_us) / 10);
 }
-}  // namespace
 
 void AutopilotLink::enable_signing(const mav::Key& key, uint8_t link_id, uint64_t persisted_timestamp) {
-  const mav::SigningClock clock = [this] { return signing_ticks(now_us_); };
+  const mav::SigningClock clock = [now = now_us_] { return signing_ticks(*now); };
   signer_.emplace(key, link_id, persisted_timestamp, clock);
   parser_.set_signing(key, /*require=*/true, clock);
 }
@@ -126,7 +122,7 @@ void AutopilotLink::emit(const Msg& msg) {
 }
 
 void AutopilotLink::receive(std::span<const uint8_t> bytes, int64_t now_us) {
-  now_us_ = std::max(now_us_, now_us);
+  advance(now_us);
   parser_.feed(bytes, [&](const mav::Frame& f) { on_frame(f, now_us); });
 }
 
@@ -163,10 +159,7 @@ void AutopilotLink::on_frame(const mav::Frame& f, int64_t now_us) {
         if constexpr (std::is_same_v<M, mav::CommandAck>) {
           on_ack(m, now_us);
         } else if constexpr (std::is_same_v<M, mav::Statustext>) {
-          const std::string text = text_of(m);
-          view_.last_statustext = std::string(severity_name(m.severity)) + ": " + text;
-          commands_.on_statustext(text);
-          log("autopilot " + view_.last_statustext);
+          on_statustext(m);
         } else if constexpr (std::is_same_v<M, mav::ExtendedSysState>) {
           if (m.landed_state != view_.landed_state) changed_ = true;
           view_.landed_state = m.landed_state;
@@ -197,6 +190,20 @@ void AutopilotLink::on_frame(const mav::Frame& f, int64_t now_us) {
         }
       },
       *msg);
+}
+
+void AutopilotLink::on_statustext(const mav::Statustext& m) {
+  // A long text comes in chunks of one id (MAVLink STATUSTEXT: id 0 = a single chunk; a chunk
+  // shorter than 50 characters is the last one).
+  const std::string chunk = text_of(m);
+  if (m.id == 0 || m.id != statustext_id_ || m.chunk_seq == 0) statustext_.clear();
+  statustext_id_ = m.id;
+  if (statustext_.size() < 8 * m.text.size()) statustext_ += chunk;  // at most 8 chunks kept
+  if (m.id != 0 && chunk.size() == m.text.size()) return;  // more to come
+  view_.last_statustext = std::string(severity_name(m.severity)) + ": " + statustext_;
+  commands_.on_statustext(statustext_);
+  log("autopilot " + view_.last_statustext);
+  statustext_.clear();
 }
 
 void AutopilotLink::on_heartbeat(const mav::Heartbeat& hb, const mav::Frame& f, int64_t now_us) {
@@ -269,11 +276,13 @@ void AutopilotLink::on_ack(const mav::CommandAck& ack, int64_t now_us) {
   if (!r) return;
   view_.last_command = command_name(r->command);
   view_.last_result = r->describe().substr(view_.last_command.size() + 2);
+  // An answered mode change is not asked for again within mode_retry_s: a refusal waits, and an
+  // acceptance shows in the next heartbeat (up to a second later).
+  if (r->command == mav::mav_cmd::kDoSetMode) mode_answered_at_us_ = now_us;
   if (r->accepted) {
     ++counters_.commands_accepted;
   } else {
     ++counters_.commands_refused;
-    if (r->command == mav::mav_cmd::kDoSetMode) mode_refused_at_us_ = now_us;
     if (r->command == mav::mav_cmd::kNavTakeoff || r->command == mav::mav_cmd::kComponentArmDisarm)
       takeoff_refused_at_us_ = now_us;  // the pilot's TAKEOFF asks again after mode_retry_s
   }
@@ -294,7 +303,7 @@ void AutopilotLink::request_mode(const std::string& name, int64_t now_us) {
 }
 
 void AutopilotLink::on_control(const ControlInput& c, int64_t now_us) {
-  now_us_ = std::max(now_us_, now_us);
+  advance(now_us);
   if (!c.velocity.allFinite() || !std::isfinite(c.yaw_rate_cw_deg_s) || c.mode < kHover || c.mode > kLand) {
     ++counters_.bad_inputs;
     return;
@@ -304,7 +313,7 @@ void AutopilotLink::on_control(const ControlInput& c, int64_t now_us) {
 }
 
 void AutopilotLink::on_nav(const NavSample& s, int64_t now_us) {
-  now_us_ = std::max(now_us_, now_us);
+  advance(now_us);
   if (!cfg_.send_odometry || view_.link != AutopilotView::Link::Ok) return;
   std::optional<mav::Odometry> o;
   try {
@@ -319,7 +328,7 @@ void AutopilotLink::on_nav(const NavSample& s, int64_t now_us) {
 }
 
 void AutopilotLink::on_target(const CameraTarget& t, int64_t now_us) {
-  now_us_ = std::max(now_us_, now_us);
+  advance(now_us);
   if (view_.link != AutopilotView::Link::Ok) return;
   try {
     if (view_.autopilot == mav::Autopilot::ArduPilot) {
@@ -335,7 +344,7 @@ void AutopilotLink::on_target(const CameraTarget& t, int64_t now_us) {
 }
 
 void AutopilotLink::on_pilot_state(int state, int64_t now_us) {
-  now_us_ = std::max(now_us_, now_us);
+  advance(now_us);
   pilot_state_ = state;
 }
 
@@ -375,10 +384,10 @@ void AutopilotLink::fly(int64_t now_us) {
   }
   if (mode == kLand || autopilot_lands) {
     stream_since_us_ = -1;
-    if (mode == kLand && !land_requested_) {
+    if (mode == kLand && !land_requested_ && view_.armed) {
       land_requested_ = true;
       send_command(mav::mav_cmd::kNavLand, {0, 0, 0, NAN, NAN, NAN, NAN}, now_us);
-    } else if (mode != kLand && autopilot_lands && !precland_) {
+    } else if (mode != kLand && autopilot_lands && !precland_ && view_.armed) {
       precland_ = true;
       log("the autopilot flies the descent: precision landing on LANDING_TARGET");
       if (view_.autopilot == mav::Autopilot::ArduPilot)
@@ -405,12 +414,12 @@ void AutopilotLink::fly(int64_t now_us) {
   }
   if (!view_.in_companion_mode && now_us - stream_since_us_ >= static_cast<int64_t>(cfg_.offboard_warmup_s * 1e6) &&
       !commands_.pending(mav::mav_cmd::kDoSetMode) &&
-      now_us - mode_refused_at_us_ >= static_cast<int64_t>(cfg_.mode_retry_s * 1e6))
+      now_us - mode_answered_at_us_ >= static_cast<int64_t>(cfg_.mode_retry_s * 1e6))
     request_mode(mav::mode_name(view_.autopilot, mav::companion_mode(view_.autopilot)), now_us);
 }
 
 std::vector<std::vector<uint8_t>> AutopilotLink::poll(int64_t now_us) {
-  now_us_ = std::max(now_us_, now_us);
+  advance(now_us);
   if (boot_us_ < 0) boot_us_ = now_us;
   if (view_.link == AutopilotView::Link::Ok &&
       now_us - view_.last_heard_us > static_cast<int64_t>(cfg_.link_timeout_s * 1e6)) {
@@ -449,7 +458,7 @@ std::vector<std::vector<uint8_t>> AutopilotLink::poll(int64_t now_us) {
     ++counters_.commands_timed_out;
     view_.last_command = command_name(r.command);
     view_.last_result = "no COMMAND_ACK (timed out)";
-    if (r.command == mav::mav_cmd::kDoSetMode) mode_refused_at_us_ = now_us;
+    if (r.command == mav::mav_cmd::kDoSetMode) mode_answered_at_us_ = now_us;
     log("command " + r.describe() + " after " + std::to_string(cfg_.command_attempts) + " attempts");
   }
   return std::exchange(out_, {});

@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -46,6 +47,10 @@
 namespace aerie::bridge {
 
 enum class LandingPath { Aerie, Autopilot };
+
+// MAVLink's signing time (10 µs ticks since 2015-01-01) of a microsecond time: Unix time, or
+// a simulation's time (which starts near 0) taken as it is.
+uint64_t signing_ticks(int64_t now_us);
 
 // Lets through one event per period on average, whatever the rate it is offered at (an event
 // is due at the period's grid, so 30 Hz out of a 200 Hz input is 30 Hz, not 200/7).
@@ -78,7 +83,7 @@ struct BridgeConfig {
   double odometry_rate_hz = 30.0;  // PX4 fuses external vision at 30-50 Hz
   double command_timeout_s = 1.0;  // per attempt, before a command is sent again
   int command_attempts = 3;
-  double mode_retry_s = 1.0;       // after a refused mode change, wait this long before asking again
+  double mode_retry_s = 1.5;       // after an answered mode change, wait this long before asking again
   double takeoff_altitude_m = 2.5; // MAV_CMD_NAV_TAKEOFF's altitude (above the take-off point)
   double camera_pitch_deg = 90;    // the landing camera's mount (pilot.yaml's camera_pitch_deg)
   LandingPath landing_path = LandingPath::Aerie;
@@ -181,23 +186,29 @@ class AutopilotLink {
   void on_frame(const mavlink::Frame& f, int64_t now_us);
   void on_heartbeat(const mavlink::Heartbeat& hb, const mavlink::Frame& f, int64_t now_us);
   void on_ack(const mavlink::CommandAck& ack, int64_t now_us);
+  void on_statustext(const mavlink::Statustext& m);
   void link_up(int64_t now_us);
   void send_command(uint16_t command, std::array<float, 7> params, int64_t now_us);
   void fly(int64_t now_us);  // the flight logic of the two landing paths, once per poll
   template <class Msg>
   void emit(const Msg& msg);
   void log(std::string line);
+  void advance(int64_t now_us) { *now_us_ = std::max(*now_us_, now_us); }
 
   BridgeConfig cfg_;
   mavlink::Parser parser_;
   std::optional<mavlink::Signer> signer_;
-  int64_t now_us_ = 0;  // the newest time passed in (dates signed frames)
+  // The newest time passed in, which dates signed frames; shared with the signing clock, so a
+  // moved link's clock still reads its own time.
+  std::shared_ptr<int64_t> now_us_ = std::make_shared<int64_t>(0);
   uint8_t seq_ = 0;
   std::vector<std::vector<uint8_t>> out_;
   CommandClient commands_;
   AutopilotView view_;
   BridgeCounters counters_;
   std::vector<std::string> log_;
+  std::string statustext_;  // chunks of a long STATUSTEXT so far
+  uint16_t statustext_id_ = 0;
   bool changed_ = false;
   std::optional<AutopilotImu> imu_;
   int64_t last_heartbeat_sent_ = -1'000'000'000;
@@ -209,7 +220,7 @@ class AutopilotLink {
   std::optional<ControlInput> control_;
   int64_t control_at_us_ = 0;       // when the newest control_cmd_t arrived
   int64_t stream_since_us_ = -1;    // the setpoint stream runs since (-1: not streaming)
-  int64_t mode_refused_at_us_ = -1'000'000'000;
+  int64_t mode_answered_at_us_ = -1'000'000'000;
   int64_t takeoff_refused_at_us_ = -1;
   bool takeoff_requested_ = false, takeoff_sent_ = false, land_requested_ = false, precland_ = false;
   std::vector<std::pair<uint32_t, double>> pending_intervals_;  // SET_MESSAGE_INTERVALs still to send

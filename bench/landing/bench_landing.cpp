@@ -30,7 +30,7 @@ using namespace aerie;
 namespace {
 
 struct Setup {
-  std::string tracker, world, controller;
+  std::string tracker, world, controller, via;
   double wind = 0;
   bool vibration = false;
 };
@@ -47,6 +47,7 @@ landing::RunConfig setup_config(const Setup& setup, const Files& files) {
   rc.sim = sim::load_flight_config(util::Config::load(files.sim_dir + "/landing_" + setup.world + ".yaml"));
   rc.sim.wind.mean_m_s = setup.wind;
   rc.sim.vibration.enabled = setup.vibration;
+  rc.via = landing::via_from_string(setup.via);
   YAML::Node pilot_yaml = YAML::LoadFile(files.pilot);
   pilot_yaml["controller"] = setup.controller;
   YAML::Emitter out;
@@ -67,7 +68,9 @@ landing::RunResult fly(const Setup& setup, landing::RunConfig rc, uint64_t seed,
     // aerie-viewer replay it like a flight log.
     log = std::make_unique<logio::Writer>(log_dir + "/" + setup.tracker + "-" + setup.controller + "-" + setup.world +
                                           "-wind" + std::to_string(static_cast<int>(setup.wind)) + "-vib" +
-                                          (setup.vibration ? "on" : "off") + "-seed" + std::to_string(seed) + ".lcm");
+                                          (setup.vibration ? "on" : "off") +
+                                          (setup.via == "direct" ? "" : "-" + setup.via) + "-seed" + std::to_string(seed) +
+                                          ".lcm");
     rc.on_message = [&log](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
       log->write(now_us, channel, data, size);
     };
@@ -113,10 +116,10 @@ std::string summary(const Setup& s, const std::vector<landing::RunResult>& runs)
   for (double& v : fit) v = n_fit ? std::sqrt(v / static_cast<double>(n_fit)) : std::nan("");
   char line[640];
   std::snprintf(line, sizeof line,
-                "%-11s %-5s %-5s wind %.0f vib %-3s: %d/%zu landed in bounds (%.1f %%), touchdown error mean %.3f m p95 "
+                "%-11s %-5s %-5s %s wind %.0f vib %-3s: %d/%zu landed in bounds (%.1f %%), touchdown error mean %.3f m p95 "
                 "%.3f m, time %.1f s, losses %.2f/run, TARGET_POSE RMSE x %.1f y %.1f z %.1f cm yaw %.2f deg (fitted "
                 "poses: x %.1f y %.1f z %.1f cm yaw %.2f deg, box-only %.1f %%), %.2f s wall per simulated s",
-                s.tracker.c_str(), s.controller.c_str(), s.world.c_str(), s.wind, s.vibration ? "on" : "off", ok,
+                s.tracker.c_str(), s.controller.c_str(), s.world.c_str(), s.via.c_str(), s.wind, s.vibration ? "on" : "off", ok,
                 runs.size(), 100.0 * ok / static_cast<double>(runs.size()), mean(err), percentile(err, 0.95),
                 mean(time), mean(losses), 100 * rm[0], 100 * rm[1], 100 * rm[2], rm[3], 100 * fit[0], 100 * fit[1],
                 100 * fit[2], fit[3], n_desc ? 100.0 * static_cast<double>(n_desc - n_fit) / static_cast<double>(n_desc) : 0.0,
@@ -130,7 +133,8 @@ int main(int argc, char** argv) {
   CLI::App app{"aerie-bench-landing: seeded autonomous landings in lock-step (CSV, summary, plots)"};
   int runs = 50, jobs = 1;
   uint64_t seed = 1;
-  std::vector<std::string> trackers{"amcmr-ct"}, worlds{"room"}, vibrations{"on"}, controllers{"fuzzy"};
+  std::vector<std::string> trackers{"amcmr-ct"}, worlds{"room"}, vibrations{"on"}, controllers{"fuzzy"}, vias{"direct"};
+  std::string autopilot = "px4";
   std::vector<double> winds{0.0};
   std::string out_dir = "bench-landing";
   Files files{"config/sim", "config/track_landing.yaml", "config/pilot.yaml", ""};
@@ -146,6 +150,12 @@ int main(int argc, char** argv) {
   app.add_option("--world", worlds, "room, field or room,field")->delimiter(',')->check(CLI::IsMember({"room", "field"}));
   app.add_option("--controller", controllers, "landing controller: fuzzy, pid or fuzzy,pid")->delimiter(',')
       ->check(CLI::IsMember({"fuzzy", "pid"}));
+  app.add_option("--via", vias, "how the pilot's commands reach the vehicle: direct (CTRL_CMD to the simulator), "
+                               "mavlink-offboard (through aerie-mavlink, Aerie flies in offboard/GUIDED), "
+                               "mavlink-precland (the autopilot's precision landing on LANDING_TARGET); comma-separated")
+      ->delimiter(',')->check(CLI::IsMember({"direct", "mavlink-offboard", "mavlink-precland"}));
+  app.add_option("--autopilot", autopilot, "the simulator's autopilot behind MAVLink: px4 or ardupilot (ArduCopter)")
+      ->check(CLI::IsMember({"px4", "ardupilot"}));
   app.add_option("--out", out_dir, "output folder (landings.csv, descent.csv, plots)");
   app.add_option("--jobs", jobs, "landings flown in parallel (threads)")->check(CLI::Range(1, 64));
   app.add_option("--sim-config-dir", files.sim_dir, "folder of landing_room.yaml and landing_field.yaml");
@@ -165,19 +175,21 @@ int main(int argc, char** argv) {
   for (const auto& w : worlds)
     for (const auto& t : trackers)
       for (const auto& c : controllers)
-        for (double wind : winds)
-          for (const auto& v : vibrations) setups.push_back({t, w, c, wind, v == "on"});
+        for (const auto& via : vias)
+          for (double wind : winds)
+            for (const auto& v : vibrations) setups.push_back({t, w, c, via, wind, v == "on"});
   if (jobs > 1) cv::setNumThreads(1);  // one core per landing
   std::filesystem::create_directories(out_dir);
   if (!files.log_dir.empty()) std::filesystem::create_directories(files.log_dir);
   std::ofstream csv(out_dir + "/landings.csv"), desc(out_dir + "/descent.csv");
   csv << "seed,tracker,world,wind_m_s,vibration,success,touchdown_error_m,yaw_error_deg,time_s,collision,losses,"
          "reacquisitions,controller,landed,timed_out,final_state,lockstep_timeouts,pose_rmse_x_m,pose_rmse_y_m,"
-         "pose_rmse_z_m,pose_rmse_yaw_deg,fit_rmse_x_m,fit_rmse_y_m,fit_rmse_z_m,fit_rmse_yaw_deg,box_poses,pad_refined,pad_not_found,tracker_reseeded,pad_misses,sim_s,wall_s\n";
+         "pose_rmse_z_m,pose_rmse_yaw_deg,fit_rmse_x_m,fit_rmse_y_m,fit_rmse_z_m,fit_rmse_yaw_deg,box_poses,pad_refined,pad_not_found,tracker_reseeded,pad_misses,sim_s,wall_s,via\n";
   desc << "seed,tracker,world,wind_m_s,vibration,controller,t_s,height_m,err_x_m,err_y_m,err_z_m,err_yaw_deg,fitted\n";
   int failures = 0;
   for (const auto& s : setups) {
-    const landing::RunConfig config = setup_config(s, files);
+    landing::RunConfig config = setup_config(s, files);
+    if (autopilot == "ardupilot") config.autopilot = sim::autopilot::Personality::ArduCopter;
     const auto results = bench::run_seeded<landing::RunResult>(
         runs, jobs, seed, "aerie-bench-landing", [&](uint64_t run_seed) { return fly(s, config, run_seed, files); }, failures);
     for (size_t i = 0; i < results.size(); ++i) {
@@ -192,7 +204,7 @@ int main(int argc, char** argv) {
           << ',' << r.final_state << ',' << r.lockstep_timeouts << ',' << r.rmse(0) << ',' << r.rmse(1) << ','
           << r.rmse(2) << ',' << r.rmse(3) << ',' << r.rmse(0, true) << ',' << r.rmse(1, true) << ',' << r.rmse(2, true)
           << ',' << r.rmse(3, true) << ',' << r.box_poses() << ',' << r.pad_refined << ',' << r.pad_not_found << ','
-          << r.tracker_reseeded << ',' << r.pad_misses << ',' << r.sim_s << ',' << r.wall_s << '\n';
+          << r.tracker_reseeded << ',' << r.pad_misses << ',' << r.sim_s << ',' << r.wall_s << ',' << s.via << '\n';
       for (const auto& d : r.descent)
         desc << run_seed << ',' << s.tracker << ',' << s.world << ',' << s.wind << ',' << vib << ',' << s.controller << ','
              << d.t << ',' << d.height << ',' << d.ex << ',' << d.ey << ',' << d.ez << ',' << d.eyaw_deg << ',' << d.fitted

@@ -9,7 +9,9 @@
 #include <map>
 #include <numbers>
 
+#include "air/mavlink/node/mavlink_node.hpp"
 #include "air/pilot/node/pilot_node.hpp"
+#include "common/sim/autopilot/mavlink_face.hpp"
 #include "common/sim/flight/node/flightsim_node.hpp"
 
 namespace aerie::landing {
@@ -30,6 +32,111 @@ int64_t RunResult::box_poses() const {
   return std::count_if(descent.begin(), descent.end(), [](const DescentSample& d) { return !d.fitted; });
 }
 
+const char* to_string(Via v) {
+  switch (v) {
+    case Via::MavlinkOffboard: return "mavlink-offboard";
+    case Via::MavlinkPrecland: return "mavlink-precland";
+    default: return "direct";
+  }
+}
+
+Via via_from_string(const std::string& name) {
+  for (Via v : {Via::Direct, Via::MavlinkOffboard, Via::MavlinkPrecland})
+    if (name == to_string(v)) return v;
+  throw std::invalid_argument("via '" + name + "': expected direct, mavlink-offboard or mavlink-precland");
+}
+
+namespace {
+
+// The vehicle behind an autopilot (Via::Mavlink*): aerie-mavlink's node on the pilot's bus and
+// the simulator's autopilot on the vehicle, joined by a byte pipe, signed with a key made for
+// the flight. Each frame, after the buses settled: the autopilot reads what the bridge wrote,
+// steps on the vehicle's state and commands the vehicle; the bridge reads its replies and
+// writes what is due. All on simulation time.
+class MavlinkPath {
+ public:
+  MavlinkPath(const RunConfig& config, bus::Bus& air, sim::FlightSim& simulator)
+      : sim_(simulator), face_(config.autopilot, autopilot_params(config)) {
+    auto [bridge_end, vehicle_end] = bridge::memory_pipe("mavlink");
+    vehicle_ = std::move(vehicle_end);
+    bridge::BridgeConfig bc = config.bridge;
+    bc.landing_path = config.via == Via::MavlinkPrecland ? bridge::LandingPath::Autopilot : bridge::LandingPath::Aerie;
+    bc.takeoff_altitude_m = simulator.vehicle().params().takeoff_height_m;
+    bc.camera_pitch_deg = config.pilot.camera_pitch_deg;
+    mavlink::Key key{};
+    for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<uint8_t>(config.sim.seed * 131 + i * 7);
+    const util::NodeClock now = [&simulator] { return simulator.utime_of(simulator.time()); };
+    bridge::AutopilotLink link(bc);
+    link.enable_signing(key, 0, 0);
+    face_.enable_signing(key, [now] { return bridge::signing_ticks(now()); });
+    bridge::MavlinkNodeOptions opt;
+    node_ = std::make_unique<bridge::MavlinkNode>(air, std::move(link), std::move(bridge_end),
+                                                  std::vector<std::unique_ptr<bridge::Endpoint>>{}, opt, now);
+  }
+
+  void step() {
+    std::vector<uint8_t> in;
+    vehicle_->read(in);
+    const double t = sim_.time();
+    face_.receive(in, t);
+    const auto out = face_.step(t, sim_.vehicle().state());
+    sim_.command(command_input(out.command));
+    vehicle_->write(out.bytes);
+    node_->step();
+  }
+
+  MavlinkCounters counters() const {
+    const auto& c = node_->link().counters();
+    MavlinkCounters m;
+    m.setpoints = c.setpoints;
+    m.landing_targets = c.landing_targets;
+    m.commands_accepted = c.commands_accepted;
+    m.commands_refused = c.commands_refused;
+    m.commands_timed_out = c.commands_timed_out;
+    m.frames_refused = static_cast<int64_t>(node_->link().parser_counters().refused() + face_.parser_counters().refused());
+    m.autopilot_mode = face_.autopilot().mode_name();
+    m.precland_state = sim::autopilot::to_string(face_.autopilot().precland_state());
+    return m;
+  }
+
+ private:
+  // The simulated vehicle holds position on optical flow (its drifting odometry, as the direct
+  // path's Multirotor does): no GPS, and no vision odometry in the landing loop.
+  static sim::autopilot::Params autopilot_params(const RunConfig& config) {
+    sim::autopilot::Params p;
+    p.EKF2_OF_CTRL = 1;
+    p.EKF2_EV_CTRL = 0;
+    p.EKF2_HGT_REF = 2;  // range finder
+    p.VISO_TYPE = 0;
+    p.EK3_SRC1_POSXY = 0;
+    p.EK3_SRC1_VELXY = 5;  // OpticalFlow
+    p.EK3_SRC1_POSZ = 2;
+    p.flow_drift_m_per_sqrt_s = config.sim.vehicle.hold_drift_m_per_sqrt_s;
+    // Climb no faster than the airframe can (the vehicle refuses commands far above its limits).
+    const double climb = config.sim.vehicle.max_vertical_speed_m_s;
+    p.MPC_TKO_SPEED = std::min(p.MPC_TKO_SPEED, climb);
+    p.WPNAV_SPEED_UP = std::min(p.WPNAV_SPEED_UP, 100 * climb);
+    p.noise_seed = config.sim.seed;
+    return p;
+  }
+
+  static sim::CommandInput command_input(const sim::AutopilotCommand& c) {
+    using Mode = sim::AutopilotCommand::Mode;
+    sim::CommandInput in;  // control_cmd_t's modes, as FlightSim takes them
+    in.mode = c.mode == Mode::Velocity ? 1 : c.mode == Mode::Takeoff ? 3 : c.mode == Mode::Land ? 4 : 0;
+    in.velocity = {c.velocity.x(), c.velocity.y(), c.velocity.z()};
+    in.yaw_rate_deg_s = c.yaw_rate_deg_s;
+    return in;
+  }
+
+  sim::FlightSim& sim_;
+  sim::autopilot::MavlinkFace face_;
+  std::unique_ptr<bridge::Endpoint> vehicle_;
+  std::unique_ptr<bridge::MavlinkNode> node_;
+};
+
+}  // namespace
+
 RunResult fly(const RunConfig& config) {
   const auto wall0 = std::chrono::steady_clock::now();
   sim::FlightSim simulator(config.sim);
@@ -39,6 +146,7 @@ RunResult fly(const RunConfig& config) {
   buses.tap(injector.tap(config.on_message));
   sim::FlightSimNodeOptions so;
   so.answer_channels.clear();  // a frame is answered when the buses are settled
+  if (config.via != Via::Direct) so.command_channel.clear();  // the autopilot commands the vehicle
   sim::FlightSimNode sim_node(air, simulator, so);
   track::NodeOptions to = config.track;
   to.every_frame = true;  // lock-step: every frame delivered is tracked
@@ -55,6 +163,8 @@ RunResult fly(const RunConfig& config) {
     if (track_node.get()) track_node.get()->wait_idle(60000);
   };
   auto pilot_state = [&] { return pilot_node.get() ? pilot_node.get()->pilot().state() : pilot::State::Idle; };
+  std::optional<MavlinkPath> mavlink;
+  if (config.via != Via::Direct) mavlink.emplace(config, air, simulator);  // the bridge flies with the vehicle
 
   RunResult r;
   std::map<int64_t, sim::TargetTruth> truth;  // of the last frames, by utime
@@ -80,6 +190,7 @@ RunResult fly(const RunConfig& config) {
     if (truth.size() > 400) truth.erase(truth.begin());  // 20 s at 20 Hz: longer than any link delay studied
     injector.step(f.t, flight);
     buses.settle(f.utime, wait_tracker);
+    if (mavlink) mavlink->step();
     if (simulator.outcome().ended() && end_frame < 0) end_frame = f.seq;
     const pilot::State s = pilot_state();
     if (end_frame >= 0 && (s == pilot::State::Landed || s == pilot::State::Aborted ||
@@ -110,6 +221,7 @@ RunResult fly(const RunConfig& config) {
   }
   r.faults = injector.report(buses, sim_node.stalled_frames(), simulator.vehicle().command_timeouts());
   r.commands_refused = simulator.commands_refused();
+  if (mavlink) r.mavlink = mavlink->counters();
   r.link_down = buses.down_counters();
   r.link_up = buses.up_counters();
   r.sim_s = simulator.time();

@@ -15,11 +15,20 @@
 
 #include "air/pilot/pilot.hpp"
 #include "air/track/node/track_node.hpp"
+#include "air/mavlink/autopilot_link.hpp"
+#include "common/sim/autopilot/sim_autopilot.hpp"
 #include "common/sim/flight/flight_sim.hpp"
 #include "tools/faults/faults.hpp"
 #include "tools/link/sim_link.hpp"
 
 namespace aerie::landing {
+
+// How the pilot's commands reach the vehicle: straight to the simulator (CTRL_CMD), or
+// through aerie-mavlink to the simulator's autopilot over MAVLink 2 (signed), which Aerie
+// flies in offboard mode or lets land on its LANDING_TARGET (docs/mavlink.md).
+enum class Via { Direct, MavlinkOffboard, MavlinkPrecland };
+const char* to_string(Via v);  // "direct", "mavlink-offboard", "mavlink-precland"
+Via via_from_string(const std::string& name);  // throws std::invalid_argument
 
 struct RunConfig {
   sim::FlightSimConfig sim;
@@ -35,6 +44,17 @@ struct RunConfig {
   link::SplitBus::Tap on_message;
   // Injected during the flight (tools/faults): nodes "track" and "pilot" can be killed.
   std::vector<faults::Fault> faults;
+  Via via = Via::Direct;
+  sim::autopilot::Personality autopilot = sim::autopilot::Personality::Px4;  // behind MAVLink
+  bridge::BridgeConfig bridge;  // aerie-mavlink's (landing_path set from `via`)
+};
+
+// aerie-mavlink's and the autopilot's counters of a flight through MAVLink.
+struct MavlinkCounters {
+  int64_t setpoints = 0, landing_targets = 0, commands_accepted = 0, commands_refused = 0, commands_timed_out = 0;
+  int64_t frames_refused = 0;      // by either side's parser
+  std::string autopilot_mode;      // at the end
+  std::string precland_state;      // PX4's precland state at the end (mavlink-precland)
 };
 
 // TARGET_POSE against the truth of its frame, during the pilot's DESCEND; fitted: the pad's
@@ -59,6 +79,7 @@ struct RunResult {
   bool dead_at_end = false;        // a node was dead when the flight ended
   double sim_s = 0, wall_s = 0;
   std::vector<DescentSample> descent;
+  MavlinkCounters mavlink;         // through MAVLink only
   // 0..2: x, y, z (m); 3: yaw (deg); over every DESCEND sample or the fitted ones; NaN without samples
   double rmse(int axis, bool fitted_only = false) const;
   int64_t box_poses() const;       // DESCEND samples from the tracker's box only

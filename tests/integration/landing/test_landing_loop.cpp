@@ -102,3 +102,48 @@ INSTANTIATE_TEST_SUITE_P(Families, LandingPerTracker, ::testing::Values("ipsl-mr
                              if (c == '-') c = '_';
                            return n;
                          });
+
+// The product through MAVLink: aerie-mavlink's node and the simulator's autopilot (PX4 and
+// ArduCopter) joined by a signed MAVLink 2 byte stream, in lock-step.
+struct ViaCase {
+  landing::Via via;
+  sim::autopilot::Personality autopilot;
+};
+
+class LandingThroughMavlink : public ::testing::TestWithParam<ViaCase> {};
+
+TEST_P(LandingThroughMavlink, LandsOnThePadAndRepeatsItselfExactly) {
+  landing::RunConfig rc = config("amcmr-ct", 3);
+  rc.sim.wind.mean_m_s = 1.0;
+  rc.sim.vibration.enabled = true;
+  rc.via = GetParam().via;
+  rc.autopilot = GetParam().autopilot;
+  landing::RunResult ra, rb;
+  const std::vector<Message> a = record(rc, &ra), b = record(rc, &rb);
+  EXPECT_TRUE(ra.score.success) << ra.final_state << ", autopilot " << ra.mavlink.autopilot_mode;  // on the pad, in time
+  EXPECT_EQ(ra.mavlink.frames_refused, 0);      // every frame of both sides verified
+  EXPECT_EQ(ra.mavlink.commands_timed_out, 0);
+  EXPECT_GT(ra.mavlink.commands_accepted, 3);   // arm, take-off, mode, land at least
+  if (rc.via == landing::Via::MavlinkOffboard) {
+    EXPECT_GT(ra.mavlink.setpoints, 100);
+  } else {
+    EXPECT_GT(ra.mavlink.landing_targets, 5);  // the autopilot landed on Aerie's LANDING_TARGET
+  }
+  ASSERT_EQ(a.size(), b.size());  // lock-step over MAVLink: the same messages, byte for byte
+  EXPECT_TRUE(a == b);
+  EXPECT_EQ(ra.score.touchdown_error_m, rb.score.touchdown_error_m);
+  bool state_seen = false;
+  for (const auto& m : a) state_seen |= m.channel == "AUTOPILOT_STATE";
+  EXPECT_TRUE(state_seen);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Paths, LandingThroughMavlink,
+    ::testing::Values(ViaCase{landing::Via::MavlinkOffboard, sim::autopilot::Personality::Px4},
+                      ViaCase{landing::Via::MavlinkPrecland, sim::autopilot::Personality::Px4},
+                      ViaCase{landing::Via::MavlinkOffboard, sim::autopilot::Personality::ArduCopter},
+                      ViaCase{landing::Via::MavlinkPrecland, sim::autopilot::Personality::ArduCopter}),
+    [](const ::testing::TestParamInfo<ViaCase>& info) {
+      return std::string(info.param.via == landing::Via::MavlinkOffboard ? "Offboard" : "Precland") +
+             (info.param.autopilot == sim::autopilot::Personality::Px4 ? "Px4" : "ArduCopter");
+    });

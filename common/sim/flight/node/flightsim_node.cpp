@@ -36,9 +36,10 @@ aerie::gt_box_t gt_box_message(const StereoFrame& down, int64_t utime, int64_t s
 
 FlightSimNode::FlightSimNode(bus::Bus& bus, FlightSim& sim, FlightSimNodeOptions options)
     : bus_(bus), sim_(sim), opt_(std::move(options)) {
-  bus_.subscribe<aerie::control_cmd_t>(opt_.command_channel, [this](const aerie::control_cmd_t& c, const bus::ReceiveInfo&) {
-    on_command(c);
-  });
+  if (!opt_.command_channel.empty())  // "" when the vehicle flies behind an autopilot (MAVLink)
+    bus_.subscribe<aerie::control_cmd_t>(opt_.command_channel, [this](const aerie::control_cmd_t& c, const bus::ReceiveInfo&) {
+      on_command(c);
+    });
   for (const auto& ch : opt_.answer_channels)
     bus_.subscribe_raw(ch, [this, ch](const uint8_t* data, size_t size, const bus::ReceiveInfo&) {
       if (const auto u = bus::peek_utime(data, size)) answered_[ch] = std::max(answered_[ch], *u);

@@ -30,7 +30,7 @@ namespace aerie::sim {
 struct FlightSimNodeOptions {
   std::vector<std::string> answer_channels{"CTRL_CMD"};
   double answer_timeout_s = 5.0;  // wall time per frame before a missing answer is counted
-  std::string command_channel = "CTRL_CMD";
+  std::string command_channel = "CTRL_CMD";  // "": none (the vehicle is commanded through its autopilot)
   std::string imu_channel = "IMU";
   std::string down_channel = "CAM_DOWN";
   std::string stereo_channel = "CAM_STEREO";
