@@ -1,6 +1,9 @@
 // aerie-sheriff: loads a procman config, sends orders to the deputies, shows a live
 // status table; runs scripts headless (--script NAME --on-script-complete exit);
 // --observe only watches (also a log being replayed).
+// Keyed (--key, docs/procman.md "Keyed mode"): orders go out tagged on PMD_ORDERS2_SEALED;
+// libbot2's unauthenticated PMD_ORDERS2 only with --insecure. Neither given: refuses to start
+// (an observer needs neither).
 #include <bot_procman/discovery_t.hpp>
 #include <bot_procman/info2_t.hpp>
 #include <bot_procman/printf_t.hpp>
@@ -15,13 +18,16 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "common/bus/bus.hpp"
 #include "common/bus/node.hpp"
+#include "common/seal/keys.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/time.hpp"
 #include "procman/channels.hpp"
+#include "procman/orders_auth.hpp"
 #include "procman/pmd_config.hpp"
 #include "procman/sheriff.hpp"
 
@@ -107,6 +113,15 @@ int main(int argc, char** argv) {
   app.add_flag("--no-table", no_table, "do not redraw the status table (state changes are still printed)");
   app.add_option("--table-period", table_period_s, "seconds between table redraws")->capture_default_str();
   app.add_flag("--show-output", show_output, "print the commands' output (PMD_PRINTF)");
+  std::string key_path;
+  bool insecure = false;
+  uint32_t sheriff_id = 0;
+  app.add_option("--key", key_path,
+                 "mission key file (mode 0600, aerie-keys generate): tag the orders with it, on " +
+                     std::string(procman::kSealedOrdersChannel) + " (the deputies need the same file)");
+  app.add_flag("--insecure,--libbot2-compatible", insecure,
+               "libbot2 mode for trusted hosts: unauthenticated orders on PMD_ORDERS2");
+  app.add_option("--sheriff-id", sheriff_id, "keyed: this sheriff's sender id (default: random per session)");
   util::add_common_options(app, common, /*with_config=*/false);
   CLI11_PARSE(app, argc, argv);
   util::init_logging("aerie-sheriff", common.log_level);
@@ -114,6 +129,27 @@ int main(int argc, char** argv) {
   try {
     if (config_path.empty() && !observe) throw std::invalid_argument("give a config file, or --observe to only watch");
     if (!script.empty() && observe) throw std::invalid_argument("--script cannot be used with --observe");
+    if (!observe && key_path.empty() && !insecure)
+      throw std::invalid_argument(
+          "refusing to send orders without a key: give the mission key with --key FILE (aerie-keys generate --out "
+          "FILE; the deputies need the same file), or --insecure for libbot2's unauthenticated PMD_ORDERS2 on a "
+          "trusted network (docs/procman.md \"Keyed mode\")");
+    if (!key_path.empty() && insecure) throw std::invalid_argument("--key and --insecure contradict each other: give one");
+    std::unique_ptr<procman::OrdersSigner> signer;
+    std::unique_ptr<seal::SecretKey> orders_key;  // to recognise other keyed sheriffs
+    std::string fingerprint;
+    if (!key_path.empty()) {
+      const seal::SecretKey key = seal::load_key(key_path);
+      while (sheriff_id == 0) sheriff_id = static_cast<uint32_t>(std::random_device{}() & 0x7fffffff);
+      signer = std::make_unique<procman::OrdersSigner>(key, sheriff_id);
+      orders_key = std::make_unique<seal::SecretKey>(procman::derive_orders_key(key));
+      fingerprint = seal::fingerprint(key);
+      spdlog::info("keyed: sheriff '{}' id {}, key {} ({}), orders on {}", name, sheriff_id, fingerprint, key_path,
+                   procman::kSealedOrdersChannel);
+    } else if (!observe) {
+      spdlog::warn("INSECURE (libbot2-compatible): unauthenticated orders on {}; any host on this LCM network can "
+                   "give the deputies orders", procman::kOrdersChannel);
+    }
     procman::PmdConfig config;
     if (!config_path.empty()) config = procman::load_pmd(config_path);
     procman::Sheriff sheriff(name, observe, deputy_timeout_s);
@@ -134,6 +170,18 @@ int main(int argc, char** argv) {
       for (std::string l; std::getline(lines, l);) std::cout << "[" << who << "] " << l << "\n";
       std::cout.flush();
     }, 1000);
+    // Another keyed sheriff giving orders: say it once per sheriff (the deputies follow one).
+    std::set<uint32_t> rivals;
+    if (orders_key) {
+      bus.subscribe_raw(procman::kSealedOrdersChannel, [&](const uint8_t* data, size_t size, const auto&) {
+        procman::VerifiedOrders v;
+        if (procman::verify_sealed_orders(*orders_key, {data, size}, v) != procman::OrdersRefusal::None) return;
+        if (v.leaving || v.sender == sheriff_id || rivals.size() >= 64 || !rivals.insert(v.sender).second) return;
+        spdlog::error("two sheriffs: '{}' (id {}) also gives orders to deputy '{}' with this key; a deputy obeys "
+                      "only one of them: stop one, or run it with --observe", v.orders.sheriff_name, v.sender,
+                      v.orders.host);
+      });
+    }
 
     const bool tty = isatty(STDOUT_FILENO) && !no_table;
     const bool typed = isatty(STDIN_FILENO) && script.empty();
@@ -197,7 +245,14 @@ int main(int argc, char** argv) {
         }
       }
       if (sheriff.take_dirty() || now >= next_orders) {
-        for (const auto& o : sheriff.orders(util::wall_utime())) bus.publish(procman::kOrdersChannel, o);
+        for (const auto& o : sheriff.orders(util::wall_utime())) {
+          if (signer) {
+            const auto sealed = signer->sign(o, util::wall_utime());
+            bus.publish_raw(procman::kSealedOrdersChannel, sealed.data(), sealed.size());
+          } else {
+            bus.publish(procman::kOrdersChannel, o);
+          }
+        }
         next_orders = now + 1000;
       }
       // State changes, one line each (what a log or a test reads).
@@ -210,7 +265,10 @@ int main(int argc, char** argv) {
         prev = s;
       }
       if (tty && now >= next_table) {
-        std::cout << "\x1b[H\x1b[2J" << "aerie-sheriff " << (observe ? "(observer) " : "") << config_path << "\n\n"
+        std::cout << "\x1b[H\x1b[2J" << "aerie-sheriff " << (observe ? "(observer) " : "") << config_path
+                  << (signer ? "  [keyed, key " + fingerprint + ", id " + std::to_string(sheriff_id) + "]"
+                             : observe ? std::string() : std::string("  [INSECURE: libbot2 mode]"))
+                  << "\n\n"
                   << sheriff.table(now);
         if (!typed_reply.empty()) std::cout << "\n" << typed_reply << "\n";
         if (typed) std::cout << "\n> " << std::flush;
@@ -240,6 +298,15 @@ int main(int argc, char** argv) {
           next_table = mono_ms();
         }
       }
+    }
+    if (signer) {
+      // "Leaving": the deputies that follow this sheriff may follow the next one at once
+      // (twice: a lost datagram only delays that to the deputy's --sheriff-handover).
+      for (int k = 0; k < 2; ++k)
+        for (const auto& o : sheriff.orders(util::wall_utime())) {
+          const auto sealed = signer->sign(o, util::wall_utime(), /*leaving=*/true);
+          bus.publish_raw(procman::kSealedOrdersChannel, sealed.data(), sealed.size());
+        }
     }
     if (runner && runner->status() == procman::ScriptRunner::Status::Failed)
       std::cerr << "script \"" << script << "\" failed: " << runner->error() << std::endl;

@@ -48,11 +48,14 @@ cleanup() {
 trap cleanup EXIT
 trap 'echo; echo "demo: interrupted; stopping the flight"' INT
 
-"$BIN/aerie-deputy" --name local >"$stem-deputy.log" 2>&1 &
+# Keyed procman (docs/procman.md "Keyed mode"): this run's own mission key (logs/ is not committed).
+mission_key="${AERIE_MISSION_KEY:-$stem-mission.key}"
+[ -f "$mission_key" ] || "$BIN/aerie-keys" generate --out "$mission_key" >/dev/null
+"$BIN/aerie-deputy" --name local --key "$mission_key" --state "$stem-deputy.counters" >"$stem-deputy.log" 2>&1 &
 deputy_pid=$!
 echo "demo: flying (procman: config/demo.pmd, seed $seed); recording $AERIE_LOG"
 status=0
-"$BIN/aerie-sheriff" config/demo.pmd --script fly --on-script-complete exit --no-table --wait-timeout 300 \
+"$BIN/aerie-sheriff" config/demo.pmd --key "$mission_key" --script fly --on-script-complete exit --no-table --wait-timeout 300 \
   >"$stem-sheriff.log" 2>&1 || status=$?
 cleanup
 trap - EXIT INT

@@ -193,7 +193,7 @@ stop_chain() {
     # In order (recorder last), then the deputy stops whatever still runs. (A Ctrl-C reached the
     # deputy too: it is already stopping everything.)
     flight_pmd "$seed" "$out/flights/unused-result.txt" >"$out/pmd/stop.pmd"
-    timeout 60 "$BIN/aerie-sheriff" "$out/pmd/stop.pmd" --script stop_all --on-script-complete exit --no-table \
+    timeout 60 "$BIN/aerie-sheriff" "$out/pmd/stop.pmd" --key "$out/mission.key" --sheriff-id 1 --script stop_all --on-script-complete exit --no-table \
       --wait-timeout 30 --deputy-wait 5 >"$out/sheriff/stop.log" 2>&1 || true
   fi
   if [ -n "$deputy_pid" ]; then
@@ -212,7 +212,10 @@ stop_chain() {
 trap stop_chain EXIT
 trap 'interrupted=1; echo; echo "soak: interrupted; stopping the chain and summarising"' INT TERM
 
-"$BIN/aerie-deputy" --name local >"$out/deputy.log" 2>&1 &
+# Keyed procman (docs/procman.md "Keyed mode"): this soak's mission key; every sheriff of the soak
+# (one per flight) is one sheriff to the deputy: --sheriff-id 1, its counters rise across them.
+[ -f "$out/mission.key" ] || "$BIN/aerie-keys" generate --out "$out/mission.key" >/dev/null
+"$BIN/aerie-deputy" --name local --key "$out/mission.key" --sheriff-id 1 --state "$out/deputy.counters" >"$out/deputy.log" 2>&1 &
 deputy_pid=$!
 # The monitor ignores SIGINT: a Ctrl-C stops the flights, not the sampling (SIGTERM at the end).
 xvfb_arg=()
@@ -229,7 +232,7 @@ t0=$(date +%s.%N)
 elapsed() { awk "BEGIN{printf \"%.3f\", $(date +%s.%N) - $t0}"; }
 
 flight_pmd "$seed" "$out/flights/unused-result.txt" >"$out/pmd/start.pmd"
-if ! "$BIN/aerie-sheriff" "$out/pmd/start.pmd" --script soak_start --on-script-complete exit --no-table \
+if ! "$BIN/aerie-sheriff" "$out/pmd/start.pmd" --key "$out/mission.key" --sheriff-id 1 --script soak_start --on-script-complete exit --no-table \
      --wait-timeout 60 >"$out/sheriff/start.log" 2>&1; then
   [ "$interrupted" = 1 ] || echo "soak: the chain did not start (see $out/sheriff/start.log)" >&2
   interrupted=1
@@ -259,7 +262,7 @@ while [ "$interrupted" = 0 ]; do
   status=0
   # flightsim ends the flight itself (landed, or 120 s of simulated flight); the sheriff's
   # wait is only a backstop for a hung one, long enough for a sanitizer build's slower sim.
-  "$BIN/aerie-sheriff" "$out/pmd/flight-$tag.pmd" --script soak_flight --on-script-complete exit --no-table \
+  "$BIN/aerie-sheriff" "$out/pmd/flight-$tag.pmd" --key "$out/mission.key" --sheriff-id 1 --script soak_flight --on-script-complete exit --no-table \
     --wait-timeout 900 >"$out/sheriff/flight-$tag.log" 2>&1 || status=$?
   end=$(elapsed)
   kill_row=",,,"

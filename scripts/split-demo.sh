@@ -103,7 +103,7 @@ if [[ $LINK -eq 1 ]]; then
   # The link's config lets no procman channel cross by default; this demo runs the air deputy
   # from the ground sheriff, so a copy names them explicitly (docs/link.md "Channels").
   awk '/^air_to_ground:/ { dir = "down" } /^ground_to_air:/ { dir = "up" }
-       /^  channels: "/ { sub(/"$/, dir == "down" ? "|PMD_INFO2|PMD_PRINTF|PMD_DISCOVER\"" : "|PMD_ORDERS2|PMD_DISCOVER\"") }
+       /^  channels: "/ { sub(/"$/, dir == "down" ? "|PMD_INFO2|PMD_PRINTF|PMD_DISCOVER\"" : "|PMD_ORDERS2_SEALED|PMD_DISCOVER\"") }
        { print }' "$LINK_CONFIG" >"$RUN_DIR/link.yaml"
   grep -q 'PMD_ORDERS2' "$RUN_DIR/link.yaml" || die "$LINK_CONFIG: no ground_to_air.channels line to add PMD_* to"
   echo "split-demo: aerie-link ($LINK_CONFIG, with PMD_* named) on the air host between $AIR_URL and $GROUND_URL"
@@ -120,14 +120,18 @@ fi
 
 mkdir -p "$(dirname "$LOG")"
 # The commands inherit the deputy's environment: their LCM URL and the log name.
-ip netns exec "$AIR" env LCM_DEFAULT_URL="$AIR_URL" "$BIN/aerie-deputy" --name air >"$RUN_DIR/deputy-air.log" 2>&1 &
+# Keyed procman (docs/procman.md "Keyed mode"): one mission key for this run, in the run's temp folder.
+MISSION_KEY="${AERIE_MISSION_KEY:-$RUN_DIR/mission.key}"
+[ -f "$MISSION_KEY" ] || "$BIN/aerie-keys" generate --out "$MISSION_KEY" >/dev/null
+ip netns exec "$AIR" env LCM_DEFAULT_URL="$AIR_URL" "$BIN/aerie-deputy" --name air --key "$MISSION_KEY" \
+  --state "$RUN_DIR/deputy-air.counters" >"$RUN_DIR/deputy-air.log" 2>&1 &
 PIDS+=($!)
 ip netns exec "$GROUND" env LCM_DEFAULT_URL="$GROUND_URL" AERIE_LOG="$LOG" "$BIN/aerie-deputy" --name ground \
-  >"$RUN_DIR/deputy-ground.log" 2>&1 &
+  --key "$MISSION_KEY" --state "$RUN_DIR/deputy-ground.counters" >"$RUN_DIR/deputy-ground.log" 2>&1 &
 PIDS+=($!)
 
 sheriff() {
-  ip netns exec "$GROUND" env LCM_DEFAULT_URL="$GROUND_URL" "$BIN/aerie-sheriff" "$CONFIG" --no-table \
+  ip netns exec "$GROUND" env LCM_DEFAULT_URL="$GROUND_URL" "$BIN/aerie-sheriff" "$CONFIG" --key "$MISSION_KEY" --no-table \
     --wait-timeout 60 --on-script-complete exit --script "$@"
 }
 t0=$(date +%s%N)

@@ -98,7 +98,8 @@ int main(int argc, char** argv) {
 
   procman::testbed::NetNamespace ns(procman::testbed::unique_name("bench-pm"));
   auto argv_deputy = ns.exec_prefix();
-  argv_deputy.insert(argv_deputy.end(), {bin + "/aerie-deputy", "--name", "bench", "--lcm-url", kUrl});
+  // libbot2 mode: this bench sends plain PMD_ORDERS2 itself.
+  argv_deputy.insert(argv_deputy.end(), {bin + "/aerie-deputy", "--name", "bench", "--lcm-url", kUrl, "--insecure"});
   procman::testbed::Process deputy(argv_deputy, out_dir + "/deputy.log");
 
   std::ostringstream pmd;
