@@ -1,4 +1,4 @@
-#include "air/mavlink/transport.hpp"
+#include "common/mavlink/transport.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -12,7 +12,7 @@
 #include <deque>
 #include <stdexcept>
 
-namespace aerie::bridge {
+namespace aerie::mavlink {
 
 namespace {
 
@@ -235,4 +235,4 @@ std::unique_ptr<Endpoint> open_endpoint(const std::string& spec) {
                               "': expected serial:DEVICE:BAUD[:rtscts], udp-listen:ADDRESS:PORT or udp:ADDRESS:PORT");
 }
 
-}  // namespace aerie::bridge
+}  // namespace aerie::mavlink

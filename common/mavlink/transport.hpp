@@ -1,5 +1,6 @@
 #pragma once
-// Byte transports to a MAVLink peer (docs/mavlink.md, "Endpoints"), named by one spec string:
+// Byte transports to a MAVLink peer (docs/mavlink.md, "Endpoints"), named by one spec string;
+// the bridge (air/mavlink) and the simulator's autopilot (common/sim/autopilot) both use them:
 //
 //   serial:/dev/ttyAMA0:921600        a UART (termios, raw, 8N1), e.g. a Pixhawk's TELEM2
 //   serial:/dev/ttyAMA0:921600:rtscts the same with hardware flow control
@@ -17,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-namespace aerie::bridge {
+namespace aerie::mavlink {
 
 class Endpoint {
  public:
@@ -52,4 +53,4 @@ std::unique_ptr<Endpoint> open_endpoint(const std::string& spec);
 // The termios speed constant of a baud rate; throws std::invalid_argument for a rate termios has not.
 unsigned baud_constant(int baud);
 
-}  // namespace aerie::bridge
+}  // namespace aerie::mavlink

@@ -57,7 +57,7 @@ class MavlinkPath {
  public:
   MavlinkPath(const RunConfig& config, bus::Bus& air, sim::FlightSim& simulator)
       : sim_(simulator), face_(config.autopilot, autopilot_params(config)) {
-    auto [bridge_end, vehicle_end] = bridge::memory_pipe("mavlink");
+    auto [bridge_end, vehicle_end] = mavlink::memory_pipe("mavlink");
     vehicle_ = std::move(vehicle_end);
     bridge::BridgeConfig bc = config.bridge;
     bc.landing_path = config.via == Via::MavlinkPrecland ? bridge::LandingPath::Autopilot : bridge::LandingPath::Aerie;
@@ -71,7 +71,7 @@ class MavlinkPath {
     face_.enable_signing(key, [now] { return bridge::signing_ticks(now()); });
     bridge::MavlinkNodeOptions opt;
     node_ = std::make_unique<bridge::MavlinkNode>(air, std::move(link), std::move(bridge_end),
-                                                  std::vector<std::unique_ptr<bridge::Endpoint>>{}, opt, now);
+                                                  std::vector<std::unique_ptr<mavlink::Endpoint>>{}, opt, now);
   }
 
   void step() {
@@ -116,6 +116,8 @@ class MavlinkPath {
     const double climb = config.sim.vehicle.max_vertical_speed_m_s;
     p.MPC_TKO_SPEED = std::min(p.MPC_TKO_SPEED, climb);
     p.WPNAV_SPEED_UP = std::min(p.WPNAV_SPEED_UP, 100 * climb);
+    p.MPC_LAND_SPEED = config.sim.vehicle.land_speed_m_s;  // the airframe's, as the direct path lands
+    p.LAND_SPEED = static_cast<int>(std::lround(100 * config.sim.vehicle.land_speed_m_s));
     p.noise_seed = config.sim.seed;
     return p;
   }
@@ -131,7 +133,7 @@ class MavlinkPath {
 
   sim::FlightSim& sim_;
   sim::autopilot::MavlinkFace face_;
-  std::unique_ptr<bridge::Endpoint> vehicle_;
+  std::unique_ptr<mavlink::Endpoint> vehicle_;
   std::unique_ptr<bridge::MavlinkNode> node_;
 };
 

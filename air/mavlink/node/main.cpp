@@ -10,7 +10,7 @@
 
 #include "air/mavlink/autopilot_link.hpp"
 #include "air/mavlink/node/mavlink_node.hpp"
-#include "air/mavlink/transport.hpp"
+#include "common/mavlink/transport.hpp"
 #include "common/mavlink/signing.hpp"
 #include "common/util/cli.hpp"
 
@@ -21,7 +21,7 @@ namespace {
 // Sends SETUP_SIGNING to the autopilot over a direct link (MAVLink's "Message Signing": the key
 // must only travel over a secure, direct connection: USB or a wire, never a radio), waits for
 // its heartbeat first; returns the exit code.
-int setup_signing(bridge::Endpoint& autopilot, const mavlink::Key& key, const bridge::BridgeConfig& cfg) {
+int setup_signing(mavlink::Endpoint& autopilot, const mavlink::Key& key, const bridge::BridgeConfig& cfg) {
   mavlink::Parser parser;
   std::vector<uint8_t> buf;
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
@@ -83,15 +83,15 @@ int main(int argc, char** argv) {
     if (key_path.empty() && !insecure)
       throw std::runtime_error("no signing key: give --key FILE (aerie-keys generate --out FILE makes one), or "
                                "--insecure to let anyone on the link command the autopilot");
-    auto autopilot = bridge::open_endpoint(autopilot_spec);
+    auto autopilot = mavlink::open_endpoint(autopilot_spec);
     std::optional<mavlink::Key> key;
     if (!key_path.empty()) key = mavlink::load_key(key_path);
     if (do_setup_signing) {
       if (!key) throw std::runtime_error("--setup-signing needs --key");
       return setup_signing(*autopilot, *key, bc);
     }
-    std::vector<std::unique_ptr<bridge::Endpoint>> ground;
-    for (const auto& spec : ground_specs) ground.push_back(bridge::open_endpoint(spec));
+    std::vector<std::unique_ptr<mavlink::Endpoint>> ground;
+    for (const auto& spec : ground_specs) ground.push_back(mavlink::open_endpoint(spec));
 
     bridge::AutopilotLink link(bc);
     bridge::MavlinkNodeOptions opt;

@@ -44,8 +44,8 @@ int8_t autopilot_code(mavlink::Autopilot a) {
 }
 }  // namespace
 
-MavlinkNode::MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<Endpoint> autopilot,
-                         std::vector<std::unique_ptr<Endpoint>> ground, MavlinkNodeOptions options,
+MavlinkNode::MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<mavlink::Endpoint> autopilot,
+                         std::vector<std::unique_ptr<mavlink::Endpoint>> ground, MavlinkNodeOptions options,
                          util::NodeClock now)
     : Node(bus, "mavlink"),
       link_(std::move(link)),

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "air/mavlink/autopilot_link.hpp"
-#include "air/mavlink/transport.hpp"
+#include "common/mavlink/transport.hpp"
 #include "common/bus/node.hpp"
 #include "common/mavlink/parser.hpp"
 #include "common/util/message_clock.hpp"
@@ -38,8 +38,8 @@ class MavlinkNode final : public bus::Node {
  public:
   // `autopilot`: the endpoint of the flight controller; `ground`: ground stations to route to.
   // `now`: the node's clock (wall clock live; simulation time in lock-step flights).
-  MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<Endpoint> autopilot,
-              std::vector<std::unique_ptr<Endpoint>> ground = {}, MavlinkNodeOptions options = {},
+  MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<mavlink::Endpoint> autopilot,
+              std::vector<std::unique_ptr<mavlink::Endpoint>> ground = {}, MavlinkNodeOptions options = {},
               util::NodeClock now = util::wall_utime);
   ~MavlinkNode() override;
 
@@ -58,8 +58,8 @@ class MavlinkNode final : public bus::Node {
   void persist_timestamp(int64_t now_us);
 
   AutopilotLink link_;
-  std::unique_ptr<Endpoint> autopilot_;
-  std::vector<std::unique_ptr<Endpoint>> ground_;
+  std::unique_ptr<mavlink::Endpoint> autopilot_;
+  std::vector<std::unique_ptr<mavlink::Endpoint>> ground_;
   std::vector<mavlink::Parser> ground_parsers_;  // frame boundaries of what the ground stations send
   MavlinkNodeOptions opt_;
   util::NodeClock now_;

@@ -759,6 +759,11 @@ bool SimAutopilot::flow_configured() const {
   return p_.EK3_SRC1_VELXY == 5;
 }
 
+bool SimAutopilot::on_flow(double t) const {
+  const bool vision_fresh = have_vision_ && t - vision_last_ <= kVisionTimeout_s + 1e-9;
+  return flow_configured() && !(fusion_configured() && vision_fresh);
+}
+
 bool SimAutopilot::vertical_from_vision() const {
   if (personality_ == Personality::Px4) return (p_.EKF2_EV_CTRL & 2) != 0 && p_.EKF2_HGT_REF == 3;
   return p_.VISO_TYPE > 0 && p_.EK3_SRC1_POSZ == 6;
@@ -852,7 +857,7 @@ void SimAutopilot::estimator_step(double t, const MultirotorState& truth) {
     have_vision_ = true;
   }
   const bool vision_fresh = have_vision_ && t - vision_last_ <= kVisionTimeout_s + 1e-9;
-  const bool flow = flow_configured() && !(fuse_xy && vision_fresh);
+  const bool flow = on_flow(t);
   if (flow) {  // optical flow integrates velocity: the position error walks
     if (flow_t_ >= 0 && t > flow_t_) {
       std::normal_distribution<double> n01(0.0, 1.0);
@@ -1180,6 +1185,20 @@ AutopilotCommand SimAutopilot::guidance(double t, const MultirotorState& truth) 
         case PrecLandState::Idle: descend_at(pl_hold_); break;
       }
       break;
+  }
+  // With no vision fused, the estimate is the vehicle's own odometry (optical flow), which the
+  // Multirotor models in its own position hold, at the physics rate and without the companion's
+  // command latency (multirotor.hpp): the autopilot's holds and its plain landing fly there
+  // rather than through a second, slower loop of this model's.
+  if (on_flow(t) && truth.armed) {
+    if (mode_ == FlightMode::Land && !tracking_target_) {
+      cmd.mode = AutopilotCommand::Mode::Land;
+      return cmd;
+    }
+    if (mode_ == FlightMode::Position || mode_ == FlightMode::Hold || mode_ == FlightMode::Brake) {
+      cmd.mode = AutopilotCommand::Mode::Hover;
+      return cmd;
+    }
   }
   if (landing && landed_) {  // touched down: motors to idle (the Multirotor disarms on contact in LAND)
     cmd.mode = AutopilotCommand::Mode::Land;

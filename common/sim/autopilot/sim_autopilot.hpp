@@ -226,6 +226,7 @@ class SimAutopilot {
   void estimator_step(double t, const MultirotorState& truth);
   bool fusion_configured() const;
   bool flow_configured() const;  // PX4 EKF2_OF_CTRL, ArduCopter EK3_SRC1_VELXY = 5 (OpticalFlow)
+  bool on_flow(double t) const;  // flow configured and no fresh vision fused: the position is the flow's
   bool vertical_from_vision() const;
 
   // guidance: desired world velocity (ENU) and clockwise yaw rate; the vehicle command

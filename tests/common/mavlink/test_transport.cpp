@@ -11,9 +11,9 @@
 #include <thread>
 #include <vector>
 
-#include "air/mavlink/transport.hpp"
+#include "common/mavlink/transport.hpp"
 
-namespace aerie::bridge {
+namespace aerie::mavlink {
 namespace {
 
 // Reads from `e` until `n` bytes arrived or a second passed.
@@ -93,4 +93,4 @@ TEST(Endpoint, MalformedSpecsAreRefusedSayingWhatIsExpected) {
 }
 
 }  // namespace
-}  // namespace aerie::bridge
+}  // namespace aerie::mavlink

@@ -9,6 +9,9 @@
 #include <thread>
 
 #include "common/bus/node.hpp"
+#include "common/mavlink/signing.hpp"
+#include "common/mavlink/transport.hpp"
+#include "common/sim/autopilot/mavlink_face.hpp"
 #include "common/sim/flight/flight_config.hpp"
 #include "common/sim/flight/node/flightsim_node.hpp"
 #include "common/util/cli.hpp"
@@ -27,7 +30,8 @@ int main(int argc, char** argv) {
   std::string vibration;
   std::vector<std::string> answers{"CTRL_CMD"};
   bool stereo = false;
-  std::string result_path;
+  std::string result_path, autopilot, mavlink_spec, mavlink_key;
+  bool insecure = false;
   app.add_option("--mode", mode, "lockstep: frame k+1 only after every answer channel answered frame k; "
                                  "realtime: frames at wall-clock rate")
       ->check(CLI::IsMember({"lockstep", "realtime"}));
@@ -42,6 +46,14 @@ int main(int argc, char** argv) {
   app.add_flag("--stereo", stereo, "also render and publish the forward stereo pair (CAM_STEREO)");
   app.add_option("--linger", linger, "seconds to keep publishing after the flight ended");
   app.add_option("--result", result_path, "also write the one-line result into this file");
+  app.add_option("--autopilot", autopilot, "put the vehicle behind a simulated autopilot that speaks MAVLink 2: px4 or "
+                                           "ardupilot (ArduCopter); CTRL_CMD is then ignored (docs/mavlink.md)")
+      ->check(CLI::IsMember({"px4", "ardupilot"}));
+  app.add_option("--mavlink", mavlink_spec, "the autopilot's MAVLink endpoint, e.g. udp-listen:127.0.0.1:14540 "
+                                            "(aerie-mavlink --autopilot udp:127.0.0.1:14540) or serial:/dev/pts/N:921600");
+  app.add_option("--mavlink-key", mavlink_key, "the autopilot's signing key (32 bytes, mode 0600): it then signs and "
+                                               "refuses unsigned frames, as PX4 once a key is set up");
+  app.add_flag("--insecure", insecure, "let the simulated autopilot run without a signing key");
   CLI11_PARSE(app, argc, argv);
   util::init_logging("flightsim", common.log_level);
   try {
@@ -58,7 +70,41 @@ int main(int argc, char** argv) {
     sim::FlightSimNodeOptions opt;
     opt.answer_channels = answers;
     opt.answer_timeout_s = timeout;
+    // Behind a simulated autopilot the vehicle obeys MAVLink alone; a frame is then answered by time.
+    std::optional<sim::autopilot::MavlinkFace> face;
+    std::unique_ptr<mavlink::Endpoint> endpoint;
+    if (!autopilot.empty()) {
+      if (mavlink_spec.empty()) throw std::runtime_error("--autopilot needs --mavlink ENDPOINT");
+      if (mavlink_key.empty() && !insecure)
+        throw std::runtime_error("--autopilot: no --mavlink-key (or --insecure to let anyone command the vehicle)");
+      if (lockstep) throw std::runtime_error("--autopilot runs in --mode realtime (lock-step flights through MAVLink: "
+                                             "aerie-bench-landing --via)");
+      face.emplace(autopilot == "px4" ? sim::autopilot::Personality::Px4 : sim::autopilot::Personality::ArduCopter);
+      if (!mavlink_key.empty()) face->enable_signing(mavlink::load_key(mavlink_key), mavlink::signing_time_now);
+      endpoint = mavlink::open_endpoint(mavlink_spec);
+      opt.command_channel.clear();
+      opt.answer_channels.clear();
+      spdlog::info("behind a simulated {} autopilot on {} ({})", autopilot, mavlink_spec,
+                   mavlink_key.empty() ? "INSECURE: unsigned" : "signed");
+    }
     sim::FlightSimNode node(bus, simulator, opt);
+    std::vector<uint8_t> bytes;
+    // The autopilot reads what came in, acts on the vehicle's state and answers, once per frame.
+    auto autopilot_step = [&] {
+      if (!face) return;
+      bytes.clear();
+      endpoint->read(bytes);
+      face->receive(bytes, simulator.time());
+      const auto out = face->step(simulator.time(), simulator.vehicle().state());
+      sim::CommandInput in;
+      using Mode = sim::AutopilotCommand::Mode;
+      in.mode = out.command.mode == Mode::Velocity ? 1 : out.command.mode == Mode::Takeoff ? 3
+                : out.command.mode == Mode::Land   ? 4 : 0;
+      in.velocity = {out.command.velocity.x(), out.command.velocity.y(), out.command.velocity.z()};
+      in.yaw_rate_deg_s = out.command.yaw_rate_deg_s;
+      simulator.command(in);
+      if (!out.bytes.empty()) endpoint->write(out.bytes);
+    };
     bus::install_stop_handlers();
     spdlog::info("{} world, seed {}, wind {} m/s, vibration {}, {} at {} Hz", fc.world.kind, fc.seed, fc.wind.mean_m_s,
                  fc.vibration.enabled ? "on" : "off", lockstep ? "lock-step" : "real time", fc.frame_rate_hz);
@@ -68,6 +114,7 @@ int main(int argc, char** argv) {
     double ended_at = -1;
     while (!bus::stop_requested()) {
       const auto& f = node.publish_next();
+      autopilot_step();
       if (lockstep) {
         node.wait_answers();
       } else {
