@@ -108,8 +108,18 @@ Command Pilot::steer(int64_t utime, double t, const Eigen::Vector3d& target, dou
   return c;
 }
 
+void Pilot::on_autopilot_link(bool ok, int64_t utime) {
+  autopilot_link_ok_ = ok;
+  if (!ok && (status_.state == State::Approach || status_.state == State::Descend)) {
+    resume_state_ = status_.state;
+    ++status_.link_holds;
+    enter(State::Hold, utime, "autopilot link lost (no heartbeat)");
+  }
+}
+
 Command Pilot::on_track(int64_t utime, TrackStatus status, std::optional<double> age_s) {
   last_track_ = utime;
+  if (!autopilot_link_ok_) return tick(utime, false, TrackStatus::Idle);  // as stale: HOLD cannot resume
   if (cfg_.max_input_age_s > 0 && age_s && *age_s > cfg_.max_input_age_s) {
     ++status_.aged_results;
     if (status_.state == State::Approach || status_.state == State::Descend) {

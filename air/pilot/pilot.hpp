@@ -104,6 +104,7 @@ struct PilotStatus {
   int stale_holds = 0;  // HOLDs entered because the tracker fell silent (inputs stale)
   int age_holds = 0;    // HOLDs entered because its results were older than max_input_age_s
   int aged_results = 0; // tracker results not flown on because of their age
+  int link_holds = 0;   // HOLDs entered because the autopilot's link was lost
 };
 
 class Pilot {
@@ -122,6 +123,10 @@ class Pilot {
   // The IMU clock: a tick (hover in HOLD, or the state's command) when the tracker has
   // been silent for stale_timeout_s; nullopt while it is not.
   std::optional<Command> on_clock(int64_t utime);
+  // The autopilot's link (AUTOPILOT_STATE from aerie-mavlink). While it is lost the pilot's
+  // commands reach nothing: it reacts as to stale inputs (APPROACH/DESCEND -> HOLD), and no
+  // tracker result resumes them until the link is back.
+  void on_autopilot_link(bool ok, int64_t utime);
   enum class Operator { Start, Abort, Land, Resume };
   // Returns false (and says why) when the command does not apply in the current state.
   bool on_operator(Operator cmd, int64_t utime, std::string* why = nullptr);
@@ -148,6 +153,7 @@ class Pilot {
   int64_t state_since_ = 0, last_track_ = -1, last_tick_ = -1;
   int lost_run_ = 0, settled_run_ = 0;
   bool started_ = false;
+  bool autopilot_link_ok_ = true;
   Command last_;
 };
 

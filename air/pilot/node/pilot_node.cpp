@@ -1,5 +1,6 @@
 #include "air/pilot/node/pilot_node.hpp"
 
+#include <aerie/autopilot_state_t.hpp>
 #include <aerie/imu_t.hpp>
 #include <aerie/pilot_cmd_t.hpp>
 #include <aerie/pilot_state_t.hpp>
@@ -56,6 +57,14 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
       if (const auto c = pilot_.on_clock(m.utime)) publish(*c);
     });
   }, 1000);  // 200 Hz: a deep queue so that a burst is not dropped
+  bus_.subscribe<aerie::autopilot_state_t>(opt_.autopilot_channel, [this](const aerie::autopilot_state_t& m,
+                                                                           const bus::ReceiveInfo&) {
+    const bool ok = m.link != aerie::autopilot_state_t::LINK_LOST;
+    if (ok == link_ok_) return;
+    link_ok_ = ok;
+    if (!ok) spdlog::warn("{}: the autopilot's link is lost: holding", opt_.autopilot_channel);
+    pilot_.on_autopilot_link(ok, now_());
+  });
   bus_.subscribe<aerie::pilot_cmd_t>(opt_.operator_channel, [this](const aerie::pilot_cmd_t& m, const bus::ReceiveInfo&) {
     // `source` is whatever the sender wrote: nothing authenticates it yet (issue 46), so the log
     // says so, and shows it quoted, at most 64 characters, control characters escaped.
@@ -165,6 +174,7 @@ void PilotNode::report(bus::StatusReporter& status) const {
   const PilotStatus& s = pilot_.status();
   status.set("losses", s.losses);
   status.set("stale_holds", s.stale_holds);
+  status.set("link_holds", s.link_holds);
   status.set("age_holds", s.age_holds);
   status.set("aged_results", s.aged_results);
   // The newest TRACK's age on this node's clock; -1 when the clocks are not comparable.

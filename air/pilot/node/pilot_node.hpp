@@ -27,6 +27,7 @@ struct PilotNodeOptions {
   std::string operator_channel = "PILOT_CMD";
   std::string command_channel = "CTRL_CMD";
   std::string state_channel = "PILOT_STATE";
+  std::string autopilot_channel = "AUTOPILOT_STATE";  // aerie-mavlink's view of the autopilot's link
 };
 
 class PilotNode {
@@ -55,6 +56,7 @@ class PilotNode {
   State last_state_ = State::Idle;
   std::optional<double> last_age_s_;
   int64_t cmd_seq_ = 0, state_seq_ = 0;
+  bool link_ok_ = true;  // the autopilot's link as AUTOPILOT_STATE last said
 };
 
 }  // namespace aerie::pilot

@@ -222,6 +222,28 @@ TEST(Pilot, ResultsOlderThanTheAgeLimitHoldAndOnlyFreshOnesResume) {
   EXPECT_EQ(f.pilot.status().age_holds, 2);
 }
 
+TEST(Pilot, ALostAutopilotLinkHoldsAsStaleInputsAndOnlyItsReturnResumes) {
+  Flight f(config());
+  f.frame();
+  f.until_change(1000);
+  f.frame(TrackStatus::Tracking, 2.0);
+  while (f.pilot.state() != State::Descend) f.frame(TrackStatus::Tracking, 2.0);
+  f.pilot.on_autopilot_link(false, f.utime);
+  EXPECT_EQ(f.pilot.state(), State::Hold);
+  EXPECT_EQ(f.pilot.status().reason, "autopilot link lost (no heartbeat)");
+  EXPECT_EQ(f.pilot.status().link_holds, 1);
+  for (int i = 0; i < 5; ++i) f.frame(TrackStatus::Tracking, 1.9);  // tracked, but nothing can fly on it
+  EXPECT_EQ(f.pilot.state(), State::Hold);
+  f.pilot.on_autopilot_link(true, f.utime);
+  f.frame(TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(f.pilot.state(), State::Descend);
+  EXPECT_EQ(f.pilot.status().reacquisitions, 1);
+  f.pilot.on_autopilot_link(false, f.utime);  // lost for good: the hold times out into an abort
+  const int held = f.until_change(10000, TrackStatus::Tracking, 1.9);
+  EXPECT_EQ(f.pilot.state(), State::Abort);
+  EXPECT_NEAR(held * 0.05, f.pilot.config().hold_timeout_s, 0.051);
+}
+
 TEST(Pilot, AnAgeLimitOfZeroIsOffAndANegativeOneIsRefused) {
   PilotConfig c = config();
   c.max_input_age_s = 0;
