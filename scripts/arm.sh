@@ -71,7 +71,7 @@ HOST_PACKAGES=(cmake ninja-build pkg-config liblcm-bin python3 "g++-$triplet" qe
 SYSROOT_PACKAGES=(libc6-dev libstdc++-12-dev libopencv-dev libopencv-contrib-dev libeigen3-dev
                   libceres-dev libblas-dev liblapack-dev liblcm-dev libglib2.0-dev libhwy-dev
                   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libgtest-dev libgmock-dev
-                  libfuzzylite-dev)
+                  libfuzzylite-dev libsodium-dev)
 
 need_root() {
   if [ "$(id -u)" -ne 0 ]; then

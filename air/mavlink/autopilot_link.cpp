@@ -64,6 +64,7 @@ BridgeConfig load_bridge(const util::Config& cfg) {
       "command_timeout_s", &BridgeConfig::command_timeout_s)("command_attempts", &BridgeConfig::command_attempts)(
       "mode_retry_s", &BridgeConfig::mode_retry_s)("takeoff_altitude_m", &BridgeConfig::takeoff_altitude_m)(
       "camera_pitch_deg", &BridgeConfig::camera_pitch_deg)("send_odometry", &BridgeConfig::send_odometry)(
+      "landing_target_fitted_only", &BridgeConfig::landing_target_fitted_only)(
       "imu_rate_hz", &BridgeConfig::imu_rate_hz)("attitude_rate_hz", &BridgeConfig::attitude_rate_hz)(
       "local_position_rate_hz", &BridgeConfig::local_position_rate_hz)(
       "extended_state_rate_hz", &BridgeConfig::extended_state_rate_hz)("battery_rate_hz", &BridgeConfig::battery_rate_hz)
@@ -329,7 +330,7 @@ void AutopilotLink::on_nav(const NavSample& s, int64_t now_us) {
 
 void AutopilotLink::on_target(const CameraTarget& t, int64_t now_us) {
   advance(now_us);
-  if (view_.link != AutopilotView::Link::Ok) return;
+  if (view_.link != AutopilotView::Link::Ok || (cfg_.landing_target_fitted_only && !t.fitted)) return;
   try {
     if (view_.autopilot == mav::Autopilot::ArduPilot) {
       emit(landing_target_ardupilot(t, body_from_camera_));

@@ -88,6 +88,11 @@ struct BridgeConfig {
   double camera_pitch_deg = 90;    // the landing camera's mount (pilot.yaml's camera_pitch_deg)
   LandingPath landing_path = LandingPath::Aerie;
   bool send_odometry = true;
+  // Only poses fitted to the pad's geometry become LANDING_TARGET: a box-only pose (the pad cut
+  // by the image border) is coarse, and the autopilot cannot tell the two apart. Its position is
+  // absolute (PX4's local frame), so below the last fitted pose the autopilot lands on it, as the
+  // pilot's blind LAND does.
+  bool landing_target_fitted_only = true;
   // Stream rates asked for on link-up (Hz; 0 = leave the autopilot's default).
   double imu_rate_hz = 100, attitude_rate_hz = 50, local_position_rate_hz = 30, extended_state_rate_hz = 5,
          battery_rate_hz = 1;

@@ -5,14 +5,17 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdio>
 #include <optional>
 #include <thread>
 
 #include "air/mavlink/autopilot_link.hpp"
 #include "air/mavlink/node/mavlink_node.hpp"
+#include "air/mavlink/preflight.hpp"
 #include "common/mavlink/transport.hpp"
 #include "common/mavlink/signing.hpp"
 #include "common/util/cli.hpp"
+#include "common/util/time.hpp"
 
 using namespace aerie;
 
@@ -46,6 +49,37 @@ int setup_signing(mavlink::Endpoint& autopilot, const mavlink::Key& key, const b
   return 0;
 }
 
+// aerie-mavlink --check (air/mavlink/preflight.hpp): the autopilot's heartbeat, version and the
+// parameters that matter, over the endpoint with the wall clock; one line per item on stdout.
+// Exit code 0 when nothing FAILs. With a key it signs and verifies as the bridge does, and saves
+// the signing timestamp, so the bridge started next never reuses one.
+int run_check(mavlink::Endpoint& autopilot, const bridge::BridgeConfig& bc, const std::optional<mavlink::Key>& key,
+              uint8_t link_id, const std::string& timestamp_file) {
+  bridge::PreflightCheck check(bridge::PreflightConfig::from(bc));
+  if (key) check.enable_signing(*key, link_id, mavlink::load_timestamp(timestamp_file));
+  spdlog::info("checking the autopilot on {} ({}, the descent flown by {}, odometry {})", autopilot.name(),
+               key ? "signed, key " + mavlink::fingerprint(*key) : std::string("unsigned"),
+               bc.landing_path == bridge::LandingPath::Aerie ? "Aerie" : "the autopilot",
+               bc.send_odometry ? "sent" : "not sent");
+  std::vector<uint8_t> buf;
+  while (!check.done()) {
+    const int64_t now_us = util::wall_utime();
+    buf.clear();
+    if (autopilot.read(buf) > 0) check.receive(buf, now_us);
+    for (const auto& frame : check.poll(now_us)) autopilot.write(frame);
+    if (buf.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (const auto ts = check.last_signing_timestamp()) mavlink::save_timestamp(timestamp_file, *ts);
+  int counts[3] = {0, 0, 0};
+  for (const auto& item : check.items()) {
+    std::printf("%s\n", bridge::to_line(item).c_str());
+    ++counts[static_cast<int>(item.verdict)];
+  }
+  std::fflush(stdout);
+  spdlog::info("{} PASS, {} WARN, {} FAIL", counts[0], counts[1], counts[2]);
+  return check.passed() ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -57,7 +91,7 @@ int main(int argc, char** argv) {
   util::add_common_options(app, common);
   std::string autopilot_spec, key_path, timestamp_path, landing;
   std::vector<std::string> ground_specs;
-  bool insecure = false, publish_imu = false, do_setup_signing = false;
+  bool insecure = false, publish_imu = false, do_setup_signing = false, do_check = false;
   int link_id = 0;
   app.add_option("--autopilot", autopilot_spec,
                  "the flight controller: serial:DEVICE:BAUD[:rtscts] (e.g. serial:/dev/ttyAMA0:921600:rtscts for a "
@@ -74,13 +108,16 @@ int main(int argc, char** argv) {
   app.add_flag("--publish-imu", publish_imu, "publish the autopilot's IMU on IMU (for aerie-nav and aerie-pilot)");
   app.add_flag("--setup-signing", do_setup_signing,
                "send the key to the autopilot with SETUP_SIGNING and exit (only over a direct wire or USB)");
+  app.add_flag("--check", do_check,
+               "check the autopilot's set-up for Aerie and exit: its heartbeat, version and parameters (PARAM_REQUEST_READ), "
+               "one PASS/WARN/FAIL line each with the fix; exit code 1 when one FAILs (signs with --key)");
   CLI11_PARSE(app, argc, argv);
   util::init_logging("mavlink", common.log_level);
   try {
     const util::Config cfg = common.config.empty() ? util::Config() : util::Config::load(common.config);
     bridge::BridgeConfig bc = bridge::load_bridge(cfg);
     if (!landing.empty()) bc.landing_path = landing == "autopilot" ? bridge::LandingPath::Autopilot : bridge::LandingPath::Aerie;
-    if (key_path.empty() && !insecure)
+    if (key_path.empty() && !insecure && !do_check)
       throw std::runtime_error("no signing key: give --key FILE (aerie-keys generate --out FILE makes one), or "
                                "--insecure to let anyone on the link command the autopilot");
     auto autopilot = mavlink::open_endpoint(autopilot_spec);
@@ -90,6 +127,9 @@ int main(int argc, char** argv) {
       if (!key) throw std::runtime_error("--setup-signing needs --key");
       return setup_signing(*autopilot, *key, bc);
     }
+    if (do_check)
+      return run_check(*autopilot, bc, key, static_cast<uint8_t>(link_id),
+                       timestamp_path.empty() ? key_path + ".timestamp" : timestamp_path);
     std::vector<std::unique_ptr<mavlink::Endpoint>> ground;
     for (const auto& spec : ground_specs) ground.push_back(mavlink::open_endpoint(spec));
 

@@ -7,6 +7,7 @@
 #include <aerie/target_pose_t.hpp>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/mavlink/signing.hpp"
@@ -63,6 +64,7 @@ MavlinkNode::MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<mavl
     c.yaw_rate_cw_deg_s = m.yaw_rate_deg_s;
     const int64_t t = now_();
     link_.on_control(c, t);
+    pending_control_utime_ = m.utime;
     flush(t);  // the setpoint leaves with the command that made it
   });
   subscribe<aerie::nav_state_t>(opt_.nav_channel, [this](const aerie::nav_state_t& m, const bus::ReceiveInfo&) {
@@ -72,7 +74,8 @@ MavlinkNode::MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<mavl
   });
   subscribe<aerie::target_pose_t>(opt_.target_channel, [this](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
     const int64_t t = now_();
-    link_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}}, t);
+    link_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.source == aerie::target_pose_t::SOURCE_FIT},
+                    t);
     flush(t);
   });
   subscribe<aerie::pilot_state_t>(opt_.pilot_state_channel, [this](const aerie::pilot_state_t& m, const bus::ReceiveInfo&) {
@@ -80,7 +83,18 @@ MavlinkNode::MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<mavl
   });
 }
 
+int64_t MavlinkNode::frame_to_wire_us(double p) const {
+  if (frame_to_wire_us_.empty()) return -1;
+  std::vector<int64_t> v = frame_to_wire_us_;
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
 MavlinkNode::~MavlinkNode() {
+  if (!frame_to_wire_us_.empty())
+    spdlog::info("camera frame to setpoint on the wire: p50 {:.2f} ms, p99 {:.2f} ms over {} setpoints",
+                 frame_to_wire_us(0.5) / 1e3, frame_to_wire_us(0.99) / 1e3, frame_to_wire_us_.size());
   const auto ts = link_.last_signing_timestamp();
   if (opt_.timestamp_file.empty() || !ts) return;
   try {
@@ -91,8 +105,15 @@ MavlinkNode::~MavlinkNode() {
 }
 
 void MavlinkNode::flush(int64_t now_us) {
+  const int64_t setpoints_before = link_.counters().setpoints;
   for (const auto& frame : link_.poll(now_us))
     if (!autopilot_->write(frame)) ++write_failures_;
+  if (link_.counters().setpoints > setpoints_before && pending_control_utime_ >= 0) {
+    if (frame_to_wire_us_.size() >= 20000)  // the last ten thousand or more (at 20 Hz: over 8 minutes)
+      frame_to_wire_us_.erase(frame_to_wire_us_.begin(), frame_to_wire_us_.begin() + 10000);
+    frame_to_wire_us_.push_back(now_() - pending_control_utime_);
+    pending_control_utime_ = -1;
+  }
   for (const std::string& line : link_.take_log()) spdlog::info("{}", line);
 }
 
@@ -211,6 +232,11 @@ void MavlinkNode::report() {
   s.set("routed_down", routed_down_);
   s.set("write_failures", write_failures_);
   s.set("endpoint_errors", endpoint_errors_);
+  if (!frame_to_wire_us_.empty() && now_() - last_stats_us_ >= 1'000'000) {  // once a second
+    last_stats_us_ = now_();
+    s.set("frame_to_wire_p50_us", frame_to_wire_us(0.5));
+    s.set("frame_to_wire_p99_us", frame_to_wire_us(0.99));
+  }
   const AutopilotView& v = link_.view();
   const std::string who = std::string(mavlink::to_string(v.autopilot)) + " " + v.mode + (v.armed ? " ARMED" : " disarmed") +
                           (link_.signing() ? ", signed" : ", UNSIGNED");

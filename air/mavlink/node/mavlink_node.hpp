@@ -50,6 +50,8 @@ class MavlinkNode final : public bus::Node {
   void step() { tick(now_()); }
 
   const AutopilotLink& link() const { return link_; }
+  // p-th percentile (0..1) of the frame-to-wire latency of the setpoints written so far (µs; -1: none).
+  int64_t frame_to_wire_us(double p) const;
   aerie::autopilot_state_t state_message(int64_t now_us) const;
 
  private:
@@ -68,6 +70,11 @@ class MavlinkNode final : public bus::Node {
   int64_t imu_seq_ = 0;
   int64_t routed_up_ = 0, routed_down_ = 0, write_failures_ = 0, endpoint_errors_ = 0;
   std::vector<uint8_t> buf_;
+  // Frame to wire: the node's time when a setpoint is written minus the utime of the camera
+  // frame its CTRL_CMD derives from (meaningful when message time is the wall clock, as live).
+  std::vector<int64_t> frame_to_wire_us_;
+  int64_t pending_control_utime_ = -1;
+  int64_t last_stats_us_ = 0;
 };
 
 }  // namespace aerie::bridge

@@ -4,7 +4,7 @@
 // companion computer's typed MAVLink messages (common/mavlink/catalogue.hpp) and the
 // simulated vehicle's AutopilotCommand (common/sim/flight/multirotor.hpp). No bytes, no
 // sockets, no LCM, no wall clock: receive() and step() take simulation time, so a lock-step
-// run is a function of its inputs. docs/mavlink_autopilot.md lists every behaviour with the
+// run is a function of its inputs. docs/mavlink.md ("The simulator's autopilot") lists every behaviour with the
 // parameter or document it models, and what is not modelled.
 //
 // Frames: the vehicle's world is ENU (x east, y north, z up; yaw counter-clockwise from east);

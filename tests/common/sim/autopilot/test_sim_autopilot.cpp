@@ -1,5 +1,5 @@
 // SimAutopilot driven in simulation time with a real Multirotor: what a companion computer
-// sees of PX4 / ArduCopter over MAVLink (docs/mavlink_autopilot.md).
+// sees of PX4 / ArduCopter over MAVLink (docs/mavlink.md ("The simulator's autopilot")).
 #include <gtest/gtest.h>
 
 #include <cmath>
