@@ -1,8 +1,11 @@
 #pragma once
 // aerie-link's configuration (config/link.yaml, documented there and in docs/link.md).
 #include <string>
+#include <vector>
 
+#include "common/seal/seal.hpp"
 #include "common/util/config.hpp"
+#include "tools/link/door.hpp"
 #include "tools/link/link_model.hpp"
 
 namespace aerie::link {
@@ -17,11 +20,22 @@ struct LinkConfig {
   DirectionConfig air_to_ground;
   DirectionConfig ground_to_air;
 
+  // The door (aerie-link --half air|ground; docs/link.md "The two halves"): per direction the
+  // rate limits of the channels that may cross (`<direction>.rate`), the rekeying of the
+  // sealed datagrams (`rekey`) and the bounds of fragment reassembly (`door`).
+  std::vector<RateRule> air_to_ground_rates;
+  std::vector<RateRule> ground_to_air_rates;
+  seal::RekeyPolicy rekey;
+  double rekey_overlap_s = 5.0;
+  ReassemblyLimits reassembly;
+
   LinkConfig();
+  // What may cross one direction at the receiving half: its channels and its rate limits.
+  DoorPolicy policy(seal::Direction d) const;
 };
 
-// Reads every key (missing keys keep the defaults above); throws std::runtime_error
-// naming the file and key for a wrong type or value.
+// Reads every key (missing keys keep the defaults above); throws std::runtime_error naming
+// the file and key for a wrong type or value, and for a key it does not know (with its line).
 LinkConfig load_link_config(const util::Config& cfg);
 
 }  // namespace aerie::link

@@ -1,10 +1,16 @@
-// aerie-link: the air-ground radio link in user space. Relays LCM channels between
-// the air network and the ground network (one regex per direction) with delay,
-// jitter, loss, a bandwidth cap with a bounded queue, optional reordering and
-// optional JPEG re-encoding of images; publishes LINK_STATS once a second.
+// aerie-link: the air-ground radio link in user space, in two modes (docs/link.md):
+//  * --half air|ground: one half of the door (tools/link/door_node.hpp) -- its host's LCM
+//    joined to a sealed UDP link towards the other half; refuses to start without --key
+//    unless --insecure is said;
+//  * without --half: the emulator, relaying LCM channels between the air network and the
+//    ground network in one process (one regex per direction).
+// Both apply delay, jitter, loss, a bandwidth cap with a bounded queue, optional reordering
+// and optional JPEG re-encoding of images, and publish LINK_STATS once a period.
 #include <aerie/link_stats_t.hpp>
+#include <fcntl.h>
 #include <poll.h>
 #include <sched.h>
+#include <unistd.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
@@ -20,10 +26,13 @@
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/time.hpp"
+#include "common/seal/keys.hpp"
+#include "tools/link/door_node.hpp"
 #include "tools/link/link_config.hpp"
 #include "tools/link/link_model.hpp"
 #include "tools/latency/stats.hpp"
 #include "tools/link/relay.hpp"
+#include "tools/link/echo_filter.hpp"
 
 namespace {
 
@@ -34,33 +43,7 @@ int64_t mono_us() {
       .count();
 }
 
-// What the relay published on a network comes back to its own subscriptions
-// there (multicast loopback): remember it briefly and drop the echo.
-class EchoFilter {
- public:
-  static uint64_t key(const std::string& channel, const uint8_t* data, size_t size) {
-    const uint64_t h1 = std::hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(data), size));
-    return h1 ^ (std::hash<std::string>{}(channel) * 0x9E3779B97F4A7C15ULL);
-  }
-  void sent(uint64_t k, int64_t now_us) {
-    keys_.insert(k);
-    order_.emplace_back(now_us, k);
-    while (!order_.empty() && now_us - order_.front().first > 5'000'000) {
-      if (auto it = keys_.find(order_.front().second); it != keys_.end()) keys_.erase(it);
-      order_.pop_front();
-    }
-  }
-  bool is_echo(uint64_t k) {
-    const auto it = keys_.find(k);
-    if (it == keys_.end()) return false;
-    keys_.erase(it);
-    return true;
-  }
-
- private:
-  std::unordered_multiset<uint64_t> keys_;
-  std::deque<std::pair<int64_t, uint64_t>> order_;
-};
+using link::EchoFilter;
 
 struct Side {
   std::string name;
@@ -100,6 +83,21 @@ int main(int argc, char** argv) {
                  "run under SCHED_FIFO at this priority (1..99; needs root or CAP_SYS_NICE) so that a busy\n"
                  "host does not add scheduling delay; 0 = normal scheduling")
       ->check(CLI::Range(0, 99));
+  std::string half, listen, peer, key_path, lcm_url, lcm_netns;
+  bool insecure = false;
+  uint32_t first_epoch = 0;
+  app.add_option("--half", half, "run one half of the door: air or ground (docs/link.md \"The two halves\")")
+      ->check(CLI::IsMember({"air", "ground"}));
+  app.add_option("--listen", listen, "half: ADDR:PORT of this half's UDP socket (the radio side)");
+  app.add_option("--peer", peer, "half: ADDR:PORT of the other half");
+  app.add_option("--key", key_path, "half: the mission key file (mode 0600; aerie-keys generate --out FILE)");
+  app.add_flag("--insecure", insecure,
+               "half: run WITHOUT a key -- datagrams in the clear, unauthenticated; the status says INSECURE");
+  app.add_option("--lcm-url", lcm_url, "half: this host's LCM URL (default: air_url or ground_url of the config)");
+  app.add_option("--lcm-netns", lcm_netns,
+                 "half: open the LCM sockets in this network namespace (e.g. /run/netns/aerie-air) after the\n"
+                 "UDP socket is opened in the current one (scripts/air-netns.sh; docs/security.md \"Deployment: one door\")");
+  app.add_option("--first-epoch", first_epoch, "half: the sealer's first key epoch (a restarted half may start higher)");
   app.add_option("--log-level", common.log_level, "trace, debug, info, warn, error, critical or off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   CLI11_PARSE(app, argc, argv);
@@ -121,6 +119,55 @@ int main(int argc, char** argv) {
       }
       if (bandwidth_kbps) d->bandwidth_bps = *bandwidth_kbps * 1000.0;
     }
+
+    if (!half.empty()) {
+      if (listen.empty() || peer.empty())
+        throw std::invalid_argument("--half " + half + " needs --listen ADDR:PORT and --peer ADDR:PORT");
+      if (!key_path.empty() && insecure) throw std::invalid_argument("--key and --insecure exclude each other");
+      if (key_path.empty() && !insecure) {
+        spdlog::critical("refusing to start the {} half without a key: give --key FILE (aerie-keys generate --out FILE, "
+                         "the same file on both hosts), or --insecure to run in the clear on purpose",
+                         half);
+        return 2;
+      }
+      std::optional<seal::SecretKey> key;
+      if (!key_path.empty()) key.emplace(seal::load_key(key_path));  // refuses a file others can read
+      if (rt_priority > 0) {
+        sched_param sp{};
+        sp.sched_priority = rt_priority;
+        if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+          spdlog::warn("cannot use SCHED_FIFO priority {}: {}", rt_priority, std::strerror(errno));
+      }
+      link::UdpSocket socket(listen);  // in the radio's namespace
+      if (!lcm_netns.empty()) {
+        const int fd = ::open(lcm_netns.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) throw std::runtime_error("--lcm-netns " + lcm_netns + ": " + std::strerror(errno));
+        if (setns(fd, CLONE_NEWNET) != 0) {
+          const std::string why = std::strerror(errno);
+          ::close(fd);
+          throw std::runtime_error("--lcm-netns " + lcm_netns + ": setns: " + why);
+        }
+        ::close(fd);
+      }
+      const link::Half h = link::half_from_name(half);
+      const std::string url = !lcm_url.empty() ? lcm_url : h == link::Half::kAir ? cfg.air_url : cfg.ground_url;
+      bus::Bus bus(url);  // LCM's sockets, in the nodes' namespace with --lcm-netns
+      link::HalfOptions opt;
+      opt.half = h;
+      opt.peer = peer;
+      opt.first_epoch = first_epoch;
+      link::DoorHalf door(bus, socket, cfg, opt, key ? &*key : nullptr);
+      const auto& o = h == link::Half::kAir ? cfg.air_to_ground : cfg.ground_to_air;
+      const auto& i = h == link::Half::kAir ? cfg.ground_to_air : cfg.air_to_ground;
+      spdlog::info("{} half: LCM {} <-> UDP {} (port {}) -> peer {}", half, url, listen, socket.port(), peer);
+      spdlog::info("sends {} '{}'; accepts {} '{}'", o.name, o.channels, i.name, i.channels);
+      if (key) spdlog::info("SECURE: key fingerprint {} (compare with the other half's)", door.fingerprint());
+      else spdlog::warn("INSECURE: no key; datagrams in the clear, unauthenticated (--insecure)");
+      door.run();
+      return 0;
+    }
+    if (!listen.empty() || !peer.empty() || !key_path.empty() || insecure || !lcm_netns.empty())
+      throw std::invalid_argument("--listen, --peer, --key, --insecure and --lcm-netns are options of --half air|ground");
 
     if (rt_priority > 0) {
       // Before the LCM threads start: they inherit the policy.

@@ -10,7 +10,10 @@ ChannelMatcher::ChannelMatcher(const std::string& regex)
 bool ChannelMatcher::operator()(const std::string& channel) {
   const auto it = cache_.find(channel);
   if (it != cache_.end()) return it->second;
-  return cache_[channel] = std::regex_match(channel, re_);
+  const bool match = std::regex_match(channel, re_);
+  // Bounded: names come from the network (a sender cycling names must not grow it).
+  if (cache_.size() < kMaxCached) cache_[channel] = match;
+  return match;
 }
 
 Relay::Relay(DirectionConfig config) : model_(config), jpeg_(config.jpeg_channels) {}

@@ -20,6 +20,7 @@ class ChannelMatcher {
   bool operator()(const std::string& channel);
 
  private:
+  static constexpr size_t kMaxCached = 4096;
   std::regex re_;
   std::unordered_map<std::string, bool> cache_;
 };

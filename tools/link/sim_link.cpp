@@ -26,8 +26,20 @@ DirectionConfig none_allowed(DirectionConfig d) {
 }
 }  // namespace
 
-SimLink::SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, const DirectionConfig& up)
+SimLink::SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, const DirectionConfig& up,
+                 const std::optional<SimDoor>& door)
     : air_(air), ground_(ground), down_(none_allowed(down)), up_(none_allowed(up)) {
+  if (door) {
+    seal::OpenerConfig o;
+    o.overlap_s = door->overlap_s;
+    const seal::SecretKey* k = door->key.get();
+    door_down_ = std::make_unique<DoorEnds>(DoorEnds{
+        DoorSender(k, seal::Direction::AirToGround, 1, 0, 0.0, door->rekey, door->limits),
+        DoorReceiver(k, seal::Direction::AirToGround, DoorPolicy{down.channels, door->down_rates}, o, door->limits)});
+    door_up_ = std::make_unique<DoorEnds>(DoorEnds{
+        DoorSender(k, seal::Direction::GroundToAir, 2, 0, 0.0, door->rekey, door->limits),
+        DoorReceiver(k, seal::Direction::GroundToAir, DoorPolicy{up.channels, door->up_rates}, o, door->limits)});
+  }
   // Deep queues: in lock-step nothing may be dropped before the link model decides.
   if (!down.channels.empty())
     air_.subscribe_raw(down.channels, [this](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
@@ -44,9 +56,21 @@ int SimLink::deliver() {
   for (Relay* r : {&down_, &up_}) {
     const Side to = r == &down_ ? Side::kGround : Side::kAir;
     bus::Bus& b = to == Side::kGround ? ground_ : air_;
+    DoorEnds* d = r == &down_ ? door_down_.get() : door_up_.get();
+    const double t = static_cast<double>(now_us_) * 1e-6;
     for (const Packet& p : r->due(now_us_)) {
-      b.publish_raw(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
-      ++n;
+      if (!d) {
+        b.publish_raw(p.channel, p.data.data(), static_cast<unsigned>(p.data.size()));
+        ++n;
+        continue;
+      }
+      // Sealed by the sending half, opened by the receiving one (refusals counted there).
+      if (!d->sender.send(p.channel, p.data, t, datagrams_)) continue;
+      for (const auto& dg : datagrams_)
+        if (auto m = d->receiver.receive(dg, t)) {
+          b.publish_raw(m->channel, m->payload.data(), static_cast<unsigned>(m->payload.size()));
+          ++n;
+        }
     }
   }
   return n;
@@ -60,7 +84,7 @@ int64_t SimLink::next_event_us() const {
 SplitBus::SplitBus(const std::optional<Split>& split) : split_(split), air_("memq://") {
   if (!split_) return;
   ground_ = std::make_unique<bus::Bus>("memq://");
-  link_ = std::make_unique<SimLink>(air_, *ground_, split_->down, split_->up);
+  link_ = std::make_unique<SimLink>(air_, *ground_, split_->down, split_->up, split_->door);
 }
 
 DirectionCounters SplitBus::down_counters() const { return link_ ? link_->down().model().counters() : DirectionCounters{}; }

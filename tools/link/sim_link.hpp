@@ -16,6 +16,8 @@
 #include <string>
 
 #include "common/bus/bus.hpp"
+#include "common/seal/keys.hpp"
+#include "tools/link/door.hpp"
 #include "tools/link/relay.hpp"
 
 namespace aerie::link {
@@ -24,16 +26,31 @@ enum class Side { kAir, kGround };
 Side side_from_name(const std::string& name);  // air | ground; throws std::invalid_argument naming it
 const char* side_name(Side side);
 
+// The door in simulation time (docs/link.md "The door in lock-step"): every message the link
+// delivers is first sealed by the sending half's DoorSender and opened by the receiving
+// half's DoorReceiver (policy: the direction's channels and `rates`), in process, with the
+// simulation's clock for rekeying -- what aerie-link --half does between the impairments and
+// the far network, without sockets.
+struct SimDoor {
+  std::shared_ptr<const seal::SecretKey> key;  // null: insecure frames (still framed and checked)
+  seal::RekeyPolicy rekey;                     // seconds of simulation time
+  double overlap_s = 5.0;
+  ReassemblyLimits limits;
+  std::vector<RateRule> down_rates, up_rates;
+};
+
 // Where each node runs, and the link between the two sides.
 struct Split {
   std::map<std::string, Side> nodes;  // nodes not named run on the air side
   DirectionConfig down, up;           // air->ground and ground->air; `channels` says what crosses ("" = nothing)
+  std::optional<SimDoor> door = std::nullopt;  // the sealed door on the link's path
   Side side(const std::string& node) const;
 };
 
 class SimLink {
  public:
-  SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, const DirectionConfig& up);
+  SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, const DirectionConfig& up,
+          const std::optional<SimDoor>& door = std::nullopt);
   SimLink(const SimLink&) = delete;
   SimLink& operator=(const SimLink&) = delete;
 
@@ -47,10 +64,18 @@ class SimLink {
 
   Relay& down() { return down_; }
   Relay& up() { return up_; }
+  // The door's ends per direction (null without a door).
+  struct DoorEnds {
+    DoorSender sender;
+    DoorReceiver receiver;
+  };
+  const DoorEnds* door(bool down) const { return down ? door_down_.get() : door_up_.get(); }
 
  private:
   bus::Bus &air_, &ground_;
   Relay down_, up_;
+  std::unique_ptr<DoorEnds> door_down_, door_up_;
+  std::vector<std::vector<uint8_t>> datagrams_;
   int64_t now_us_ = 0;
 };
 
