@@ -111,7 +111,8 @@ case "$CMD" in
   nodes)
     exists "$NODES" || die "no namespace '$NODES' (air-netns.sh up first)"
     [[ $# -ge 1 ]] || die "nodes: give the command after --"
-    exec ip netns exec "$NODES" "$@"
+    # A secure deployment: a node that takes commands refuses a network-facing LCM URL (ttl > 0).
+    AERIE_DEPLOYMENT=secure exec ip netns exec "$NODES" "$@"
     ;;
   *)
     die "unknown command '$CMD' (up, door, nodes, check, down; see --help)"

@@ -13,6 +13,8 @@ aerie_local_lcm() {
   # recv_buf_size: every node's socket receives every channel; the 208 KiB default dropped
   # 14,000-37,000 datagrams per node in the 30 min soak under load (docs/results/soak.md).
   export LCM_DEFAULT_URL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304'
+  # A node that takes commands then refuses a URL with ttl > 0 (common/bus/deployment.hpp).
+  export AERIE_DEPLOYMENT=secure
   if ! ip route show 224.0.0.0/4 2>/dev/null | grep -q .; then
     if [ "$(id -u)" -eq 0 ]; then
       ip route add 224.0.0.0/4 dev lo

@@ -8,6 +8,7 @@
 
 #include "air/control/control_config.hpp"
 #include "air/control/control_node.hpp"
+#include "common/bus/deployment.hpp"
 #include "common/bus/node.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/util/cli.hpp"
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   try {
     const util::Config cfg = common.config.empty() ? util::Config() : util::Config::load(common.config);
     const control::NodeSetup setup = control::node_setup(cfg, cli);
+    bus::require_host_local_commands("aerie-control", "FLC_PARAMS", common.lcm_url);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "control");
     control::ControlNode node(bus, status, setup.controller, setup.options);

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "common/bus/deployment.hpp"
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/heap.hpp"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
     if (resolution > 0) cfg.occupancy.resolution = resolution;
     if (max_range > 0) cfg.occupancy.sensor_model.max_range = max_range;
 
+    aerie::bus::require_host_local_commands("aerie-map", "MAP_CMD and MAP_QUERY", opts.lcm_url);
     aerie::bus::Bus bus(opts.lcm_url);
     aerie::bus::StatusReporter status(bus, "aerie-map");
     aerie::map::MapService service(bus, status, cfg);

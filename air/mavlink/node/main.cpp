@@ -12,6 +12,7 @@
 #include "air/mavlink/autopilot_link.hpp"
 #include "air/mavlink/node/mavlink_node.hpp"
 #include "air/mavlink/preflight.hpp"
+#include "common/bus/deployment.hpp"
 #include "common/mavlink/transport.hpp"
 #include "common/mavlink/signing.hpp"
 #include "common/util/cli.hpp"
@@ -143,6 +144,7 @@ int main(int argc, char** argv) {
     } else {
       spdlog::warn("INSECURE: MAVLink signing is off; anyone on {} can command the autopilot", autopilot_spec);
     }
+    bus::require_host_local_commands("aerie-mavlink", "CTRL_CMD", common.lcm_url);
     bus::Bus bus(common.lcm_url);
     bridge::MavlinkNode node(bus, std::move(link), std::move(autopilot), std::move(ground), opt);
     spdlog::info("autopilot on {}, {} ground station(s), the descent flown by {}", autopilot_spec, ground_specs.size(),

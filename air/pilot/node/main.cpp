@@ -7,6 +7,7 @@
 
 #include "air/pilot/node/pilot_node.hpp"
 #include "air/pilot/pilot_config.hpp"
+#include "common/bus/deployment.hpp"
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
 
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
       pc = pilot::load_pilot_config(util::Config::parse(out.c_str(), cfg.origin()));
     }
     if (wait_for_start) pc.wait_for_start = true;
+    bus::require_host_local_commands("aerie-pilot", "PILOT_CMD", common.lcm_url);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "pilot");
     pilot::PilotNode node(bus, pc);

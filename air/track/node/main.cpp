@@ -5,6 +5,7 @@
 
 #include "air/track/factory.hpp"
 #include "air/track/node/track_node.hpp"
+#include "common/bus/deployment.hpp"
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     opt.every_frame = replay;
     if (target_size > 0) opt.target.width_m = opt.target.height_m = target_size;
 
+    aerie::bus::require_host_local_commands("aerie-track", "TRACK_CMD", common.lcm_url);
     aerie::bus::Bus bus(common.lcm_url);
     aerie::bus::StatusReporter status(bus, "track");
     aerie::track::TrackNode node(bus, opt);
