@@ -4,6 +4,7 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -16,10 +17,135 @@ int64_t now_ms() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
+
+// A status older than this is shown as silent (door halves and aerie-mavlink send at 1 Hz).
+constexpr double kSilentS = 5.0;
+
+// One door half as its status tells it (tools/link/door_node.cpp refresh_status/status_line):
+// counters "secure" (1/0) and "epoch"; the fingerprint only in the message
+// ("SECURE key <fingerprint> epoch ...").
+struct DoorHalfState {
+  bool secure = false;
+  std::string fingerprint;
+  int64_t epoch = -1;
+};
+DoorHalfState door_half(const aerie::process_status_t& m) {
+  DoorHalfState h;
+  bool has_secure = false;
+  for (int i = 0; i < m.ncounters && i < static_cast<int>(std::min(m.counter_names.size(), m.counter_values.size())); ++i) {
+    const std::string& n = m.counter_names[i];
+    if (n == "secure") {
+      h.secure = m.counter_values[i] != 0;
+      has_secure = true;
+    } else if (n == "epoch") {
+      h.epoch = m.counter_values[i];
+    }
+  }
+  if (!has_secure) h.secure = m.message.rfind("SECURE", 0) == 0;
+  const auto k = m.message.find("key ");
+  if (h.secure && k != std::string::npos) {
+    const auto b = k + 4;
+    h.fingerprint = m.message.substr(b, m.message.find_first_of(" ;", b) - b);
+  }
+  if (h.secure && h.fingerprint.empty()) h.fingerprint = "?";
+  return h;
+}
+
+std::string silent(double age_s) {
+  return age_s > kSilentS ? " silent " + std::to_string(static_cast<int64_t>(age_s)) + " s" : "";
+}
+
+// "3fa2:1b4c:d5e6:f789" -> "3fa2:…": the summary line fits the panel; the halves' lines show it whole.
+std::string short_fingerprint(const std::string& fp) {
+  const auto colon = fp.find(':');
+  return colon == std::string::npos ? fp : fp.substr(0, colon + 1) + "\u2026";
+}
 }  // namespace
 
-ProcmanPanel::ProcmanPanel(std::string status_channels)
-    : Renderer("processes"), status_channels_(std::move(status_channels)) {}
+ProcmanPanel::ProcmanPanel(std::string status_channels, std::string autopilot_channel)
+    : Renderer("processes"),
+      status_channels_(std::move(status_channels)),
+      autopilot_channel_(std::move(autopilot_channel)) {}
+
+std::vector<ProcmanPanel::Line> ProcmanPanel::door_lines(const aerie::process_status_t* air, double air_age_s,
+                                                         const aerie::process_status_t* ground,
+                                                         double ground_age_s) {
+  if (!air && !ground) return {};
+  std::optional<DoorHalfState> a, g;
+  if (air) a = door_half(*air);
+  if (ground) g = door_half(*ground);
+  const bool air_insecure = a && !a->secure, ground_insecure = g && !g->secure;
+  std::vector<Line> lines;
+  if (air_insecure || ground_insecure) {
+    const char* which = air_insecure && ground_insecure ? "both halves" : air_insecure ? "air half" : "ground half";
+    lines.push_back({std::string("door: INSECURE (") + which + ": no key)", true});
+  } else if (a && g && a->fingerprint != g->fingerprint) {
+    lines.push_back({"door: KEY MISMATCH (air != ground)", true});
+  } else if (a && g) {
+    lines.push_back({"door: SECURE " + short_fingerprint(a->fingerprint) + " (air and ground agree)", false});
+  } else {
+    lines.push_back({"door: SECURE " + short_fingerprint((a ? a : g)->fingerprint) + (a ? " (ground" : " (air") +
+                         " not heard)",
+                     false});
+  }
+  auto half = [&](const char* name, const std::optional<DoorHalfState>& h, double age_s) {
+    char line[160];
+    if (!h)
+      std::snprintf(line, sizeof line, "  %-6s not heard", name);
+    else if (!h->secure)
+      std::snprintf(line, sizeof line, "  %-6s INSECURE%s", name, silent(age_s).c_str());
+    else
+      std::snprintf(line, sizeof line, "  %-6s SECURE %s ep %lld%s", name, h->fingerprint.c_str(),
+                    static_cast<long long>(h->epoch), silent(age_s).c_str());
+    const bool mismatch = h && h->secure && a && g && a->secure && g->secure && a->fingerprint != g->fingerprint;
+    lines.push_back({line, (h && !h->secure) || mismatch || (h && age_s > kSilentS)});
+  };
+  half("air", a, air_age_s);
+  half("ground", g, ground_age_s);
+  return lines;
+}
+
+std::vector<ProcmanPanel::Line> ProcmanPanel::autopilot_lines(const aerie::autopilot_state_t& s, double age_s) {
+  using A = aerie::autopilot_state_t;
+  std::vector<Line> lines;
+  if (s.link == A::LINK_NONE) {
+    lines.push_back({"autopilot: no heartbeat yet" + silent(age_s), age_s > kSilentS});
+  } else {
+    const char* ap = s.autopilot == A::AUTOPILOT_PX4 ? "PX4" : s.autopilot == A::AUTOPILOT_ARDUPILOT ? "ArduPilot" : "autopilot";
+    const bool lost = s.link != A::LINK_OK;
+    lines.push_back({std::string("autopilot: ") + ap + " " + (s.mode.empty() ? "?" : s.mode) + " " +
+                         (s.armed ? "ARMED" : "disarmed") + " " + (s.signing ? "signed" : "UNSIGNED"),
+                     !s.signing});
+    lines.push_back({std::string("  link ") + (lost ? "LOST" : "OK") + silent(age_s), lost || age_s > kSilentS});
+  }
+  if (!s.last_command.empty()) {
+    const std::string& r = s.last_result;
+    const bool refused = !r.empty() && r.rfind("ACCEPTED", 0) != 0 && r.rfind("IN_PROGRESS", 0) != 0;
+    const std::string cmd = s.last_command.rfind("MAV_CMD_", 0) == 0 ? s.last_command.substr(8) : s.last_command;
+    lines.push_back({"  " + cmd + ": " + (r.empty() ? "no answer yet" : r), refused});
+  }
+  return lines;
+}
+
+std::vector<ProcmanPanel::Line> ProcmanPanel::alerts() const {
+  std::lock_guard lock(m_);
+  const int64_t now = now_ms();
+  auto find = [&](const char* channel, double& age_s) -> const aerie::process_status_t* {
+    const auto it = nodes_.find(channel);
+    if (it == nodes_.end()) return nullptr;
+    age_s = static_cast<double>(now - node_ms_.at(channel)) * 1e-3;
+    return &it->second;
+  };
+  double air_age = 0, ground_age = 0;
+  const auto* air = find("STATUS_LINK_AIR", air_age);
+  const auto* ground = find("STATUS_LINK_GROUND", ground_age);
+  std::vector<Line> lines = door_lines(air, air_age, ground, ground_age);
+  if (autopilot_) {
+    auto ap = autopilot_lines(*autopilot_, static_cast<double>(now - autopilot_ms_) * 1e-3);
+    lines.insert(lines.end(), ap.begin(), ap.end());
+  }
+  return lines;
+}
 
 void ProcmanPanel::subscribe(bus::Bus& bus) {
   bus_ = &bus;
@@ -27,8 +153,16 @@ void ProcmanPanel::subscribe(bus::Bus& bus) {
                                          [this](const aerie::process_status_t& m, const bus::ReceiveInfo& info) {
                                            std::lock_guard lock(m_);
                                            nodes_[info.channel] = m;
+                                           node_ms_[info.channel] = now_ms();
                                            ++version_;
                                          });
+  bus.subscribe<aerie::autopilot_state_t>(autopilot_channel_,
+                                          [this](const aerie::autopilot_state_t& m, const bus::ReceiveInfo&) {
+                                            std::lock_guard lock(m_);
+                                            autopilot_ = m;
+                                            autopilot_ms_ = now_ms();
+                                            ++version_;
+                                          });
   bus.subscribe<bot_procman::info2_t>("PMD_INFO2", [this](const bot_procman::info2_t& m, const bus::ReceiveInfo&) {
     std::lock_guard lock(m_);
     observer_.on_info(m, now_ms());
@@ -48,6 +182,7 @@ void ProcmanPanel::attach(Layout& layout) {
   actor_->GetPositionCoordinate()->SetValue(0.02, 0.97);
   actor_->SetInput("processes: waiting for PMD_INFO2 and STATUS_*");
   layout.panel->AddActor2D(actor_);
+  panel_ = layout.panel;
 }
 
 bot_procman::orders2_t ProcmanPanel::orders_for(const bot_procman::info2_t& info, int32_t sheriff_id, bool start,
@@ -151,12 +286,38 @@ bool ProcmanPanel::update() {
     if (version_ == seen_) return false;
     seen_ = version_;
   }
-  actor_->SetInput(text().c_str());
+  // Each alert line is its own actor (its own colour) at the panel's corner, pushed down by
+  // blank lines; the processes follow below them.
+  const std::vector<Line> lines = alerts();
+  std::string pad;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (i == alert_actors_.size()) {
+      auto a = vtkSmartPointer<vtkTextActor>::New();
+      a->GetTextProperty()->ShallowCopy(actor_->GetTextProperty());
+      a->SetTextScaleModeToNone();
+      a->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+      a->GetPositionCoordinate()->SetValue(actor_->GetPositionCoordinate()->GetValue());
+      a->SetVisibility(actor_->GetVisibility());
+      panel_->AddActor2D(a);
+      alert_actors_.push_back(a);
+    }
+    auto* p = alert_actors_[i]->GetTextProperty();
+    p->SetBold(lines[i].alarm);
+    if (lines[i].alarm) p->SetColor(1.0, 0.25, 0.2);
+    else p->SetColor(0.55, 0.95, 0.55);
+    alert_actors_[i]->SetInput((pad + lines[i].text).c_str());
+    pad += " \n";
+  }
+  for (size_t i = lines.size(); i < alert_actors_.size(); ++i) alert_actors_[i]->SetInput("");
+  const std::string body = text();
+  if (!lines.empty() && body.front() != '\n') pad += " \n";  // one blank line between them
+  actor_->SetInput((pad + body).c_str());
   return true;
 }
 
 void ProcmanPanel::on_enabled(bool on) {
   if (actor_) actor_->SetVisibility(on);
+  for (auto& a : alert_actors_) a->SetVisibility(on);
 }
 
 }  // namespace aerie::viewer

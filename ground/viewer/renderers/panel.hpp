@@ -1,11 +1,15 @@
 #pragma once
 // The process panel: procman hosts and commands (from the deputies' PMD_INFO2 reports:
 // state, CPU, memory, restarts) with start/stop of the selected command, and below them
-// every node's heartbeat (STATUS_*: health and last message).
+// every node's heartbeat (STATUS_*: health and last message). Above them, one line each
+// for the air-ground door (STATUS_LINK_AIR/_GROUND, tools/link/door_node.hpp: SECURE with
+// the key fingerprint per half, INSECURE or a fingerprint mismatch in red) and for the
+// autopilot as aerie-mavlink hears it (AUTOPILOT_STATE, docs/mavlink.md).
 //
 // Start/stop works as a libbot2 sheriff does: the panel sends PMD_ORDERS2 for that
 // deputy built from its latest report, with only the selected command changed. While an
 // `aerie-sheriff` (not in observer mode) runs, its own orders prevail: use it to control.
+#include <aerie/autopilot_state_t.hpp>
 #include <aerie/process_status_t.hpp>
 #include <bot_procman/info2_t.hpp>
 #include <bot_procman/orders2_t.hpp>
@@ -14,23 +18,39 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "ground/viewer/renderer.hpp"
 #include "procman/sheriff.hpp"
 
+class vtkRenderer;
 class vtkTextActor;
 
 namespace aerie::viewer {
 
 class ProcmanPanel : public Renderer {
  public:
-  explicit ProcmanPanel(std::string status_channels = "STATUS_.*");
+  explicit ProcmanPanel(std::string status_channels = "STATUS_.*", std::string autopilot_channel = "AUTOPILOT_STATE");
   void subscribe(bus::Bus& bus) override;
   void attach(Layout& layout) override;
   bool update() override;
   // '[' / ']' select the previous / next command, 's' starts or stops it.
   bool on_key(const std::string& key) override;
   std::string text() const;
+  // A line drawn above the processes; `alarm` draws it in red.
+  struct Line {
+    std::string text;
+    bool alarm = false;
+  };
+  // The door and autopilot lines as drawn (empty until a STATUS_LINK_* or AUTOPILOT_STATE).
+  std::vector<Line> alerts() const;
+  // The door's lines from the two halves' status (nullptr: not heard; age_s: since the last).
+  static std::vector<Line> door_lines(const aerie::process_status_t* air, double air_age_s,
+                                      const aerie::process_status_t* ground, double ground_age_s);
+  // The autopilot's lines from AUTOPILOT_STATE (age_s: since it arrived).
+  static std::vector<Line> autopilot_lines(const aerie::autopilot_state_t& s, double age_s);
   // Sends orders that start (or stop) the selected command; false when none is selected.
   bool toggle_selected();
   size_t selected() const { return selected_; }
@@ -44,14 +64,19 @@ class ProcmanPanel : public Renderer {
   void on_enabled(bool on) override;
 
  private:
-  std::string status_channels_;
+  std::string status_channels_, autopilot_channel_;
   bus::Bus* bus_ = nullptr;
   mutable std::mutex m_;
   procman::Sheriff observer_{"aerie-viewer", true};
   std::map<std::string, aerie::process_status_t> nodes_;
+  std::map<std::string, int64_t> node_ms_;  // when each status arrived (steady ms)
+  std::optional<aerie::autopilot_state_t> autopilot_;
+  int64_t autopilot_ms_ = 0;
   uint64_t version_ = 0, seen_ = 0;
   size_t selected_ = 0;
   vtkSmartPointer<vtkTextActor> actor_;
+  std::vector<vtkSmartPointer<vtkTextActor>> alert_actors_;  // one per line, all at actor_'s corner
+  vtkRenderer* panel_ = nullptr;
 };
 
 }  // namespace aerie::viewer

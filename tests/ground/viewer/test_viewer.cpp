@@ -7,12 +7,14 @@
 #include <link.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
+#include <aerie/autopilot_state_t.hpp>
 #include <aerie/control_cmd_t.hpp>
 #include <aerie/process_status_t.hpp>
 #include <bot_procman/info2_t.hpp>
@@ -137,6 +139,55 @@ aerie::track_t box_track(int64_t utime, double x0, double y0, double x1, double 
   t.confidence = 0.9f;
   t.nlevels = 0;
   return t;
+}
+
+// A door half's status as tools/link/door_node.cpp publishes it (refresh_status, status_line).
+aerie::process_status_t door_status(const char* half, const char* fingerprint, int64_t epoch = 3) {
+  aerie::process_status_t m{};
+  m.utime = util::wall_utime();
+  m.node = std::string("link-") + half;
+  m.host = half;
+  m.pid = 1;
+  const bool secure = fingerprint != nullptr;
+  m.health = secure ? aerie::process_status_t::OK : aerie::process_status_t::WARN;
+  m.message = secure ? "SECURE key " + std::string(fingerprint) + " epoch " + std::to_string(epoch) +
+                           " peer epoch 2; " + half + " half, sends up"
+                     : "INSECURE: no key (--insecure), datagrams in the clear and unauthenticated; " +
+                           std::string(half) + " half, sends up";
+  for (auto [name, value] : {std::pair<const char*, int64_t>{"up.sent", 10}, {"epoch", epoch}, {"peer_epoch", 2},
+                             {"secure", secure ? 1 : 0}}) {
+    m.counter_names.push_back(name);
+    m.counter_values.push_back(value);
+  }
+  m.ncounters = static_cast<int32_t>(m.counter_names.size());
+  m.ntimings = 0;
+  return m;
+}
+
+aerie::autopilot_state_t autopilot_state(bool signing, int8_t link = aerie::autopilot_state_t::LINK_OK) {
+  aerie::autopilot_state_t s{};
+  s.utime = util::wall_utime();
+  s.seq = 1;
+  s.link = link;
+  s.autopilot = aerie::autopilot_state_t::AUTOPILOT_PX4;
+  s.system_id = 1;
+  s.component_id = 1;
+  s.armed = true;
+  s.mode = "OFFBOARD";
+  s.aerie_in_control = true;
+  s.signing = signing;
+  s.battery_voltage_v = 16.2f;
+  s.battery_remaining_pct = 80;
+  s.link_quality = 1;
+  s.last_command = "MAV_CMD_COMPONENT_ARM_DISARM";
+  s.last_result = "ACCEPTED";
+  return s;
+}
+
+std::string joined(const std::vector<ProcmanPanel::Line>& lines) {
+  std::string s;
+  for (const auto& l : lines) s += (l.alarm ? "[red] " : "") + l.text + "\n";
+  return s;
 }
 
 }  // namespace
@@ -458,4 +509,142 @@ TEST_F(Fixture, PublishesItsStatusWithTheHeapAndTrimsIt) {
   const double span_s = (statuses.back().utime - statuses.front().utime) * 1e-6;
   EXPECT_LE(last["heap_trims"] - counters(statuses.front())["heap_trims"], span_s / o.trim_period_s + 1);
   EXPECT_GE(last["heap_released_kb"], 0);
+}
+
+constexpr const char* kFp = "3fa2:1b4c:d5e6:f789";
+
+TEST(PanelAlerts, DoorSecureWhenBothHalvesHaveTheSameKey) {
+  const auto air = door_status("air", kFp), ground = door_status("ground", kFp, 4);
+  const auto lines = ProcmanPanel::door_lines(&air, 1, &ground, 1);
+  ASSERT_EQ(lines.size(), 3u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "door: SECURE 3fa2:\u2026 (air and ground agree)");
+  EXPECT_EQ(lines[1].text, "  air    SECURE 3fa2:1b4c:d5e6:f789 ep 3");
+  EXPECT_EQ(lines[2].text, "  ground SECURE 3fa2:1b4c:d5e6:f789 ep 4");
+  for (const auto& l : lines) EXPECT_FALSE(l.alarm) << l.text;
+  EXPECT_TRUE(ProcmanPanel::door_lines(nullptr, 0, nullptr, 0).empty());  // no door: no lines
+}
+
+TEST(PanelAlerts, DoorInsecureOnEitherHalfIsRed) {
+  const auto air = door_status("air", nullptr), ground = door_status("ground", kFp);
+  auto lines = ProcmanPanel::door_lines(&air, 1, &ground, 1);
+  ASSERT_EQ(lines.size(), 3u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "door: INSECURE (air half: no key)");
+  EXPECT_TRUE(lines[0].alarm);
+  EXPECT_EQ(lines[1].text, "  air    INSECURE");
+  EXPECT_TRUE(lines[1].alarm);
+  EXPECT_FALSE(lines[2].alarm) << lines[2].text;  // the ground half itself is secure
+  const auto ground_insecure = door_status("ground", nullptr);
+  lines = ProcmanPanel::door_lines(&air, 1, &ground_insecure, 1);
+  EXPECT_EQ(lines[0].text, "door: INSECURE (both halves: no key)");
+  lines = ProcmanPanel::door_lines(nullptr, 0, &ground_insecure, 1);
+  EXPECT_EQ(lines[0].text, "door: INSECURE (ground half: no key)");
+  EXPECT_EQ(lines[1].text, "  air    not heard");
+}
+
+TEST(PanelAlerts, DoorFingerprintMismatchIsAnErrorShowingBothFingerprints) {
+  const auto air = door_status("air", kFp), ground = door_status("ground", "77aa:0000:1111:2222");
+  const auto lines = ProcmanPanel::door_lines(&air, 1, &ground, 1);
+  ASSERT_EQ(lines.size(), 3u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "door: KEY MISMATCH (air != ground)");
+  EXPECT_EQ(lines[1].text, "  air    SECURE 3fa2:1b4c:d5e6:f789 ep 3");
+  EXPECT_EQ(lines[2].text, "  ground SECURE 77aa:0000:1111:2222 ep 3");
+  for (const auto& l : lines) EXPECT_TRUE(l.alarm) << l.text;
+}
+
+TEST(PanelAlerts, DoorHalfHeardAloneOrSilentSaysSo) {
+  const auto ground = door_status("ground", kFp);
+  auto lines = ProcmanPanel::door_lines(nullptr, 0, &ground, 1);
+  ASSERT_EQ(lines.size(), 3u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "door: SECURE 3fa2:\u2026 (air not heard)");
+  EXPECT_EQ(lines[1].text, "  air    not heard");
+  const auto air = door_status("air", kFp);
+  lines = ProcmanPanel::door_lines(&air, 12.4, &ground, 1);  // the air half's status stopped crossing
+  EXPECT_EQ(lines[1].text, "  air    SECURE 3fa2:1b4c:d5e6:f789 ep 3 silent 12 s");
+  EXPECT_TRUE(lines[1].alarm);
+  EXPECT_FALSE(lines[2].alarm);
+}
+
+TEST(PanelAlerts, AutopilotLinkModeArmingSigningAndLastCommand) {
+  using A = aerie::autopilot_state_t;
+  auto s = autopilot_state(true);
+  auto lines = ProcmanPanel::autopilot_lines(s, 0.5);
+  ASSERT_EQ(lines.size(), 3u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "autopilot: PX4 OFFBOARD ARMED signed");
+  EXPECT_EQ(lines[1].text, "  link OK");
+  EXPECT_EQ(lines[2].text, "  COMPONENT_ARM_DISARM: ACCEPTED");
+  for (const auto& l : lines) EXPECT_FALSE(l.alarm) << l.text;
+
+  s.signing = false;
+  s.link = A::LINK_LOST;
+  s.armed = false;
+  s.autopilot = A::AUTOPILOT_ARDUPILOT;
+  s.mode = "GUIDED";
+  s.last_result = "DENIED (Arming denied: not ready)";
+  lines = ProcmanPanel::autopilot_lines(s, 0.5);
+  ASSERT_EQ(lines.size(), 3u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "autopilot: ArduPilot GUIDED disarmed UNSIGNED");
+  EXPECT_EQ(lines[1].text, "  link LOST");
+  EXPECT_EQ(lines[2].text, "  COMPONENT_ARM_DISARM: DENIED (Arming denied: not ready)");
+  for (const auto& l : lines) EXPECT_TRUE(l.alarm) << l.text;
+
+  s = autopilot_state(true);
+  s.last_result.clear();
+  lines = ProcmanPanel::autopilot_lines(s, 9);  // aerie-mavlink went quiet
+  EXPECT_EQ(lines[1].text, "  link OK silent 9 s");
+  EXPECT_TRUE(lines[1].alarm);
+  EXPECT_EQ(lines[2].text, "  COMPONENT_ARM_DISARM: no answer yet");
+  EXPECT_FALSE(lines[2].alarm);
+  s.link = A::LINK_NONE;
+  s.last_command.clear();
+  lines = ProcmanPanel::autopilot_lines(s, 0.5);
+  ASSERT_EQ(lines.size(), 1u) << joined(lines);
+  EXPECT_EQ(lines[0].text, "autopilot: no heartbeat yet");
+}
+
+// Red pixels (the alarm colour) inside the process panel of a snapshot.
+int red_pixels_in_panel(const cv::Mat& img, Viewer& v) {
+  const double* vp = v.layout().panel->GetViewport();  // x0 y0 x1 y1, normalized, origin bottom-left
+  const int w = img.cols, h = img.rows;
+  const cv::Rect r(cvRound(vp[0] * w), cvRound((1 - vp[3]) * h), cvRound((vp[2] - vp[0]) * w),
+                   cvRound((vp[3] - vp[1]) * h));
+  int n = 0;
+  for (int y = r.y; y < r.y + r.height; ++y)
+    for (int x = r.x; x < r.x + r.width; ++x) {
+      const cv::Vec3b c = img.at<cv::Vec3b>(y, x);
+      n += c[2] > 200 && c[1] < 110 && c[0] < 110;
+    }
+  return n;
+}
+
+TEST_F(Fixture, PanelShowsTheDoorAndTheAutopilotFromTheirChannelsInRedWhenInsecure) {
+  make();
+  auto* panel = dynamic_cast<ProcmanPanel*>(viewer->find("processes"));
+  ASSERT_NE(panel, nullptr);
+  bus.publish("STATUS_LINK_AIR", door_status("air", kFp));
+  bus.publish("STATUS_LINK_GROUND", door_status("ground", kFp));
+  bus.publish("AUTOPILOT_STATE", autopilot_state(true));
+  ASSERT_TRUE(render_until([&] { return panel->alerts().size() == 6; })) << joined(panel->alerts());
+  auto lines = panel->alerts();
+  EXPECT_EQ(lines[0].text, "door: SECURE 3fa2:\u2026 (air and ground agree)");
+  EXPECT_EQ(lines[3].text, "autopilot: PX4 OFFBOARD ARMED signed");
+  EXPECT_EQ(lines[4].text, "  link OK");
+  EXPECT_EQ(lines[5].text, "  COMPONENT_ARM_DISARM: ACCEPTED");
+  viewer->render_frame();
+  cv::Mat img = snapshot();
+  EXPECT_EQ(red_pixels_in_panel(img, *viewer), 0);
+  if (const char* keep = std::getenv("AERIE_VIEWER_KEEP_SNAPSHOT")) cv::imwrite(std::string(keep) + "/secure.png", img);
+
+  bus.publish("STATUS_LINK_AIR", door_status("air", nullptr));  // the air half restarted --insecure
+  ASSERT_TRUE(render_until([&] { return panel->alerts()[0].text.find("INSECURE") != std::string::npos; }))
+      << joined(panel->alerts());
+  lines = panel->alerts();
+  EXPECT_EQ(lines[0].text, "door: INSECURE (air half: no key)");
+  EXPECT_TRUE(lines[0].alarm);
+  EXPECT_FALSE(lines[3].alarm);
+  viewer->render_frame();
+  img = snapshot();
+  EXPECT_GT(red_pixels_in_panel(img, *viewer), 50);
+  if (const char* keep = std::getenv("AERIE_VIEWER_KEEP_SNAPSHOT")) cv::imwrite(std::string(keep) + "/insecure.png", img);
+  // The door's own status lines are still listed with the other nodes below.
+  EXPECT_NE(panel->text().find("link-air"), std::string::npos) << panel->text();
 }
