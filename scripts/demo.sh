@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The autonomous demo flight (README's first command):
-#   bash scripts/demo.sh [--seed N]
+#   bash scripts/demo.sh [--seed N] [--mavlink | --precland]
 # Installs missing packages and builds (scripts/build.sh), then flies the closed loop in
 # real time under procman, as config/demo.pmd writes it: the simulated drone takes off in
 # the textured room, surveys, finds the helipad with its down camera, approaches, descends
@@ -9,14 +9,21 @@
 # dashboard snapshot. It ends with one line (landed or not, touchdown error, time), the
 # log's summary (aerie-log info) and the files written. Ctrl-C stops the flight early; the
 # log is still closed and summarised. About a minute.
+#   --mavlink   the pilot's commands go through aerie-mavlink (signed MAVLink 2 over UDP) to the
+#               simulator's PX4 autopilot, which Aerie flies in OFFBOARD (docs/mavlink.md)
+#   --precland  the same, and the autopilot lands itself on Aerie's LANDING_TARGET (AUTO.PRECLAND)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seed=1
+script=fly
+export AERIE_LANDING=aerie
 while [ $# -gt 0 ]; do
   case "$1" in
     --seed) seed="$2"; shift 2 ;;
-    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    --mavlink) script=fly_mavlink; shift ;;
+    --precland) script=fly_mavlink; AERIE_LANDING=autopilot; shift ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     *) echo "demo: unknown option '$1' (see --help)" >&2; exit 1 ;;
   esac
 done
@@ -51,11 +58,15 @@ trap 'echo; echo "demo: interrupted; stopping the flight"' INT
 # Keyed procman (docs/procman.md "Keyed mode"): this run's own mission key (logs/ is not committed).
 mission_key="${AERIE_MISSION_KEY:-$stem-mission.key}"
 [ -f "$mission_key" ] || "$BIN/aerie-keys" generate --out "$mission_key" >/dev/null
+# The MAVLink signing key shared by aerie-mavlink and the simulated autopilot (--mavlink, --precland).
+export AERIE_MAVLINK_KEY="$stem-mavlink.key"
+[ "$script" = fly ] || "$BIN/aerie-keys" generate --out "$AERIE_MAVLINK_KEY" >/dev/null
 "$BIN/aerie-deputy" --name local --key "$mission_key" --state "$stem-deputy.counters" >"$stem-deputy.log" 2>&1 &
 deputy_pid=$!
-echo "demo: flying (procman: config/demo.pmd, seed $seed); recording $AERIE_LOG"
+via="directly"; [ "$script" = fly_mavlink ] && via="through MAVLink ($([ "$AERIE_LANDING" = autopilot ] && echo "the autopilot's precision landing" || echo "Aerie flies in OFFBOARD"))"
+echo "demo: flying $via (procman: config/demo.pmd, script $script, seed $seed); recording $AERIE_LOG"
 status=0
-"$BIN/aerie-sheriff" config/demo.pmd --key "$mission_key" --script fly --on-script-complete exit --no-table --wait-timeout 300 \
+"$BIN/aerie-sheriff" config/demo.pmd --key "$mission_key" --script "$script" --on-script-complete exit --no-table --wait-timeout 300 \
   >"$stem-sheriff.log" 2>&1 || status=$?
 cleanup
 trap - EXIT INT

@@ -56,7 +56,7 @@ namespace {
 class MavlinkPath {
  public:
   MavlinkPath(const RunConfig& config, bus::Bus& air, sim::FlightSim& simulator)
-      : sim_(simulator), face_(config.autopilot, autopilot_params(config)) {
+      : sim_(simulator), face_(config.autopilot, sim::autopilot::airframe_params(config.sim.vehicle, config.sim.seed)) {
     auto [bridge_end, vehicle_end] = mavlink::memory_pipe("mavlink");
     vehicle_ = std::move(vehicle_end);
     bridge::BridgeConfig bc = config.bridge;
@@ -100,28 +100,6 @@ class MavlinkPath {
   }
 
  private:
-  // The simulated vehicle holds position on optical flow (its drifting odometry, as the direct
-  // path's Multirotor does): no GPS, and no vision odometry in the landing loop.
-  static sim::autopilot::Params autopilot_params(const RunConfig& config) {
-    sim::autopilot::Params p;
-    p.EKF2_OF_CTRL = 1;
-    p.EKF2_EV_CTRL = 0;
-    p.EKF2_HGT_REF = 2;  // range finder
-    p.VISO_TYPE = 0;
-    p.EK3_SRC1_POSXY = 0;
-    p.EK3_SRC1_VELXY = 5;  // OpticalFlow
-    p.EK3_SRC1_POSZ = 2;
-    p.flow_drift_m_per_sqrt_s = config.sim.vehicle.hold_drift_m_per_sqrt_s;
-    // Climb no faster than the airframe can (the vehicle refuses commands far above its limits).
-    const double climb = config.sim.vehicle.max_vertical_speed_m_s;
-    p.MPC_TKO_SPEED = std::min(p.MPC_TKO_SPEED, climb);
-    p.WPNAV_SPEED_UP = std::min(p.WPNAV_SPEED_UP, 100 * climb);
-    p.MPC_LAND_SPEED = config.sim.vehicle.land_speed_m_s;  // the airframe's, as the direct path lands
-    p.LAND_SPEED = static_cast<int>(std::lround(100 * config.sim.vehicle.land_speed_m_s));
-    p.noise_seed = config.sim.seed;
-    return p;
-  }
-
   static sim::CommandInput command_input(const sim::AutopilotCommand& c) {
     using Mode = sim::AutopilotCommand::Mode;
     sim::CommandInput in;  // control_cmd_t's modes, as FlightSim takes them

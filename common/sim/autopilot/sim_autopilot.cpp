@@ -11,6 +11,24 @@
 
 namespace aerie::sim::autopilot {
 
+Params airframe_params(const MultirotorParams& vehicle, uint64_t seed) {
+  Params p;
+  p.EKF2_OF_CTRL = 1;
+  p.EKF2_EV_CTRL = 0;
+  p.EKF2_HGT_REF = 2;  // range finder
+  p.VISO_TYPE = 0;
+  p.EK3_SRC1_POSXY = 0;
+  p.EK3_SRC1_VELXY = 5;  // OpticalFlow
+  p.EK3_SRC1_POSZ = 2;   // range finder
+  p.flow_drift_m_per_sqrt_s = vehicle.hold_drift_m_per_sqrt_s;
+  p.MPC_TKO_SPEED = std::min(p.MPC_TKO_SPEED, vehicle.max_vertical_speed_m_s);
+  p.WPNAV_SPEED_UP = std::min(p.WPNAV_SPEED_UP, 100 * vehicle.max_vertical_speed_m_s);
+  p.MPC_LAND_SPEED = vehicle.land_speed_m_s;
+  p.LAND_SPEED = static_cast<int>(std::lround(100 * vehicle.land_speed_m_s));
+  p.noise_seed = seed;
+  return p;
+}
+
 const char* to_string(PrecLandState s) {
   switch (s) {
     case PrecLandState::Idle: return "idle";

@@ -96,6 +96,12 @@ struct Params {
   void validate() const;  // throws std::invalid_argument naming the field
 };
 
+// The autopilot as set up on the simulated airframe when no vision is fused: it holds position
+// on optical flow (the vehicle's own drifting odometry, MultirotorParams::hold_drift_m_per_sqrt_s),
+// its height on a range finder, and climbs and lands at the airframe's speeds (the vehicle refuses
+// commands far above its limits). Used by the landing bench and by aerie-flightsim --autopilot.
+Params airframe_params(const MultirotorParams& vehicle, uint64_t seed);
+
 // A parameter as PARAM_VALUE reports it.
 struct ParamEntry {
   std::string name;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <thread>
 
+#include "common/bus/deployment.hpp"
 #include "common/bus/node.hpp"
 #include "common/mavlink/signing.hpp"
 #include "common/mavlink/transport.hpp"
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
     if (!vibration.empty()) fc.vibration.enabled = vibration == "on";
     if (stereo) fc.stereo = true;
     sim::FlightSim simulator(fc);
+    bus::require_host_local_commands("aerie-flightsim", "CTRL_CMD", common.lcm_url);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "flightsim");
     const bool lockstep = mode == "lockstep";
@@ -79,7 +81,8 @@ int main(int argc, char** argv) {
         throw std::runtime_error("--autopilot: no --mavlink-key (or --insecure to let anyone command the vehicle)");
       if (lockstep) throw std::runtime_error("--autopilot runs in --mode realtime (lock-step flights through MAVLink: "
                                              "aerie-bench-landing --via)");
-      face.emplace(autopilot == "px4" ? sim::autopilot::Personality::Px4 : sim::autopilot::Personality::ArduCopter);
+      face.emplace(autopilot == "px4" ? sim::autopilot::Personality::Px4 : sim::autopilot::Personality::ArduCopter,
+                   sim::autopilot::airframe_params(fc.vehicle, fc.seed));
       if (!mavlink_key.empty()) face->enable_signing(mavlink::load_key(mavlink_key), mavlink::signing_time_now);
       endpoint = mavlink::open_endpoint(mavlink_spec);
       opt.command_channel.clear();
@@ -112,6 +115,7 @@ int main(int argc, char** argv) {
     // Real time: message time is wall time, so that latency tools and other nodes' clocks agree.
     if (!lockstep && fc.start_utime == 0) simulator.set_start_utime(wall0);
     double ended_at = -1;
+    std::string touchdown_mode;  // the simulated autopilot's mode when the flight ended
     while (!bus::stop_requested()) {
       const auto& f = node.publish_next();
       autopilot_step();
@@ -124,7 +128,10 @@ int main(int argc, char** argv) {
       }
       node.report(status);
       status.tick();
-      if (simulator.outcome().ended() && ended_at < 0) ended_at = f.t;
+      if (simulator.outcome().ended() && ended_at < 0) {
+        ended_at = f.t;
+        if (face) touchdown_mode = face->autopilot().mode_name();
+      }
       if (ended_at >= 0 && f.t >= ended_at + linger) break;
     }
     const auto& o = simulator.outcome();
@@ -139,11 +146,15 @@ int main(int argc, char** argv) {
       std::snprintf(line, sizeof line, "NOT LANDED (%s) after %.1f s",
                     o.collided ? ("collision: " + o.collision).c_str() : o.timed_out ? "timed out" : "stopped",
                     simulator.time());
-    std::printf("flightsim: %s\n", line);
+    std::string result = line;
+    if (face)
+      result += std::string(", through MAVLink to a simulated ") + (autopilot == "px4" ? "PX4" : "ArduCopter") +
+                " (" + touchdown_mode + " at the end)";
+    std::printf("flightsim: %s\n", result.c_str());
     if (!result_path.empty()) {
       std::FILE* f = std::fopen(result_path.c_str(), "w");
       if (!f) throw std::runtime_error("--result: cannot write '" + result_path + "'");
-      std::fprintf(f, "%s\n", line);
+      std::fprintf(f, "%s\n", result.c_str());
       std::fclose(f);
     }
     return 0;
