@@ -385,7 +385,7 @@ void AutopilotLink::fly(int64_t now_us) {
   }
   if (mode == kLand || autopilot_lands) {
     stream_since_us_ = -1;
-    if (mode == kLand && !land_requested_ && view_.armed) {
+    if (mode == kLand && !land_requested_ && view_.armed && !precland_) {  // the precision landing goes on
       land_requested_ = true;
       send_command(mav::mav_cmd::kNavLand, {0, 0, 0, NAN, NAN, NAN, NAN}, now_us);
     } else if (mode != kLand && autopilot_lands && !precland_ && view_.armed) {

@@ -275,6 +275,36 @@ TEST_F(Fixture, SignedBothWaysAndUnsignedFramesOfTheAutopilotRefused) {
   EXPECT_EQ(link->parser_counters().bad_signature, 1u);
 }
 
+TEST_F(Fixture, ThePrecisionLandingIsAskedForAtTheDescentAndTheTouchdownDoesNotReplaceIt) {
+  cfg.landing_path = LandingPath::Autopilot;
+  link = std::make_unique<AutopilotLink>(cfg);
+  px4.armed = true;
+  px4.custom_mode = mav::px4::custom_mode(mav::px4::kOffboard);
+  hear(px4.heartbeat());
+  auto lands = [&] {
+    std::vector<mav::CommandLong> out;
+    for (const auto& c : only<mav::CommandLong>(poll()))
+      if (c.command == mav::mav_cmd::kNavLand) out.push_back(c);
+    return out;
+  };
+  link->on_pilot_state(4, now);  // APPROACH: the pilot flies
+  link->on_control(control(1, {0.2, 0, 0}), now);
+  EXPECT_TRUE(lands().empty());
+  now += 50 * kMs;
+  link->on_pilot_state(5, now);  // DESCEND: the autopilot lands on LANDING_TARGET
+  link->on_control(control(1, {0, 0, -0.3}), now);
+  const auto first = lands();
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0].param2, 2.0f);  // precision landing required: AUTO.PRECLAND
+  hear(px4.ack(mav::mav_cmd::kNavLand, mav::mav_result::kAccepted));
+  for (int k = 0; k < 10; ++k) {  // TOUCHDOWN: the pilot's LAND must not turn it into a plain AUTO.LAND
+    now += 50 * kMs;
+    link->on_pilot_state(6, now);
+    link->on_control(control(4), now);
+    EXPECT_TRUE(lands().empty());
+  }
+}
+
 TEST(BridgeConfig, RefusesValuesOutsideTheirRangeNamingTheKey) {
   BridgeConfig c;
   c.setpoint_rate_hz = 2;
