@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "air/mavlink/autopilot_link.hpp"
@@ -303,6 +304,31 @@ TEST_F(Fixture, ThePrecisionLandingIsAskedForAtTheDescentAndTheTouchdownDoesNotR
     link->on_control(control(4), now);
     EXPECT_TRUE(lands().empty());
   }
+}
+
+TEST_F(Fixture, TheAutopilotsImuComesOutInAeriesBodyFrame) {
+  hear(px4.heartbeat());
+  mav::AttitudeQuaternion att;  // facing east: +90 deg about NED's z (down)
+  att.q1 = static_cast<float>(std::cos(M_PI / 4));
+  att.q4 = static_cast<float>(std::sin(M_PI / 4));
+  hear(px4.frame(att));
+  mav::HighresImu imu;  // at rest, level: the specific force points up, -z in FRD; turning right
+  imu.zacc = -9.81f;
+  imu.xacc = 0.5f;   // accelerating forward
+  imu.yacc = 0.25f;  // and to the right
+  imu.zgyro = 0.1f;  // yawing clockwise seen from above
+  hear(px4.frame(imu));
+  const auto s = link->take_imu();
+  ASSERT_TRUE(s);
+  EXPECT_NEAR((s->linear_acceleration - Eigen::Vector3d(0.5, -0.25, 9.81)).norm(), 0, 1e-5);  // FLU
+  EXPECT_NEAR((s->angular_velocity - Eigen::Vector3d(0, 0, -0.1)).norm(), 0, 1e-6);  // counter-clockwise positive
+  ASSERT_TRUE(s->orientation);
+  // The nose (body x) points east: in the z-up world (north, west, up) that is -y.
+  const Eigen::Vector3d nose = *s->orientation * Eigen::Vector3d::UnitX();
+  EXPECT_NEAR((nose - Eigen::Vector3d(0, -1, 0)).norm(), 0, 1e-6);
+  const Eigen::Vector3d up = *s->orientation * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR((up - Eigen::Vector3d(0, 0, 1)).norm(), 0, 1e-6);
+  EXPECT_FALSE(link->take_imu());  // taken once
 }
 
 TEST(BridgeConfig, RefusesValuesOutsideTheirRangeNamingTheKey) {
