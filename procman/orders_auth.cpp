@@ -12,7 +12,7 @@
 #include <stdexcept>
 
 #include "common/bus/wire.hpp"
-#include "common/util/secret_file.hpp"
+#include "common/util/key_file.hpp"
 
 namespace aerie::procman {
 namespace {
@@ -333,7 +333,7 @@ bool OrdersGate::save_state(std::string* error) {
                      "; per sheriff id the last counter accepted\n";
   for (const auto& [sender, counter] : last_) text += std::to_string(sender) + " " + std::to_string(counter) + "\n";
   try {
-    util::write_secret_file(options_.state_path, std::vector<uint8_t>(text.begin(), text.end()), /*overwrite=*/true,
+    util::write_key_file(options_.state_path, std::vector<uint8_t>(text.begin(), text.end()), /*overwrite=*/true,
                             "deputy state file");
     return true;
   } catch (const std::exception& e) {

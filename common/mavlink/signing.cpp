@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "common/mavlink/frame.hpp"
-#include "common/util/secret_file.hpp"
+#include "common/util/key_file.hpp"
 
 namespace aerie::mavlink {
 
@@ -145,14 +145,14 @@ std::string to_string(Verifier::Verdict verdict) {
 // --- keys and timestamps --------------------------------------------------------------------
 
 Key load_key(const std::string& path) {
-  const std::vector<uint8_t> bytes = util::read_secret_file(path, 32, "MAVLink signing key");
+  const std::vector<uint8_t> bytes = util::read_key_file(path, 32, "MAVLink signing key");
   Key key{};
   std::copy_n(bytes.begin(), key.size(), key.begin());
   return key;
 }
 
 void save_key(const std::string& path, const Key& key, bool overwrite) {
-  util::write_secret_file(path, std::vector<uint8_t>(key.begin(), key.end()), overwrite, "MAVLink signing key");
+  util::write_key_file(path, std::vector<uint8_t>(key.begin(), key.end()), overwrite, "MAVLink signing key");
 }
 
 Key generate_key() {

@@ -101,7 +101,7 @@ class Verifier {
 
 std::string to_string(Verifier::Verdict verdict);
 
-// Keys: 32 raw bytes in a file of mode 0600 (common/util/secret_file.hpp).
+// Keys: 32 raw bytes in a file of mode 0600 (common/util/key_file.hpp).
 Key load_key(const std::string& path);
 void save_key(const std::string& path, const Key& key, bool overwrite = false);
 Key generate_key();  // libsodium randombytes

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "common/util/secret_file.hpp"
+#include "common/util/key_file.hpp"
 
 namespace aerie::seal {
 
@@ -61,7 +61,7 @@ bool SecretKey::equals(const SecretKey& other) const {
 
 SecretKey load_key(const std::string& path) {
   init_sodium();
-  std::vector<uint8_t> bytes = util::read_secret_file(path, SecretKey::kSize, "mission key");
+  std::vector<uint8_t> bytes = util::read_key_file(path, SecretKey::kSize, "mission key");
   SecretKey key = SecretKey::from_bytes(bytes);
   sodium_memzero(bytes.data(), bytes.size());
   return key;
@@ -70,7 +70,7 @@ SecretKey load_key(const std::string& path) {
 void save_key(const std::string& path, const SecretKey& key, bool overwrite) {
   std::vector<uint8_t> bytes(key.data(), key.data() + key.size());
   try {
-    util::write_secret_file(path, bytes, overwrite, "mission key");
+    util::write_key_file(path, bytes, overwrite, "mission key");
   } catch (...) {
     sodium_memzero(bytes.data(), bytes.size());
     throw;

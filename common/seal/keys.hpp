@@ -1,6 +1,6 @@
 #pragma once
 // The mission key: 32 random bytes shared by the air and the ground half of the link, kept in a
-// file of mode 0600 (common/util/secret_file.hpp), never logged, printed or sent. Operators
+// file of mode 0600 (common/util/key_file.hpp), never logged, printed or sent. Operators
 // compare fingerprints, never keys (docs/security.md, "Key files and fingerprints").
 #include <array>
 #include <cstddef>
@@ -41,7 +41,7 @@ class SecretKey {
   std::array<uint8_t, kSize> bytes_{};
 };
 
-// Reads a mission key file (util::read_secret_file: mode 0600 or stricter, exactly 32 bytes;
+// Reads a mission key file (util::read_key_file: mode 0600 or stricter, exactly 32 bytes;
 // errors name the file, never the content).
 SecretKey load_key(const std::string& path);
 // Writes a mission key file with mode 0600; refuses to replace an existing one unless `overwrite`.

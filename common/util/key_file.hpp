@@ -12,11 +12,11 @@ namespace aerie::util {
 // Throws std::runtime_error "PATH: <what> not found" / "... must be a regular file" /
 // "... is readable or writable by others (mode 0644); chmod 600 PATH" /
 // "... holds N bytes, expected M".
-std::vector<uint8_t> read_secret_file(const std::string& path, size_t expected_size,
+std::vector<uint8_t> read_key_file(const std::string& path, size_t expected_size,
                                       const std::string& what = "key file");
 // Writes `bytes` to `path` (mode 0600, created next to it and renamed over it, so a reader
 // never sees a partial key). Refuses to replace an existing file unless `overwrite`.
-void write_secret_file(const std::string& path, const std::vector<uint8_t>& bytes, bool overwrite = false,
+void write_key_file(const std::string& path, const std::vector<uint8_t>& bytes, bool overwrite = false,
                        const std::string& what = "key file");
 
 }  // namespace aerie::util

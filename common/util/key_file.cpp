@@ -1,4 +1,4 @@
-#include "common/util/secret_file.hpp"
+#include "common/util/key_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -21,7 +21,7 @@ std::string octal_mode(mode_t mode) {
 }
 }  // namespace
 
-std::vector<uint8_t> read_secret_file(const std::string& path, size_t expected_size, const std::string& what) {
+std::vector<uint8_t> read_key_file(const std::string& path, size_t expected_size, const std::string& what) {
   require_regular_file(path, what);
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
   if (fd < 0) throw std::runtime_error(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
@@ -55,7 +55,7 @@ std::vector<uint8_t> read_secret_file(const std::string& path, size_t expected_s
   return bytes;
 }
 
-void write_secret_file(const std::string& path, const std::vector<uint8_t>& bytes, bool overwrite,
+void write_key_file(const std::string& path, const std::vector<uint8_t>& bytes, bool overwrite,
                        const std::string& what) {
   if (!overwrite && ::access(path.c_str(), F_OK) == 0)
     throw std::runtime_error(path + ": " + what + " exists already (refusing to overwrite it)");
