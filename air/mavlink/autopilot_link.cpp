@@ -55,7 +55,6 @@ void BridgeConfig::validate() const {
 
 BridgeConfig load_bridge(const util::Config& cfg) {
   BridgeConfig c;
-  std::string path = "aerie";
   util::SectionReader<BridgeConfig>(cfg, c)("system_id", &BridgeConfig::system_id)(
       "component_id", &BridgeConfig::component_id)("autopilot_system_id", &BridgeConfig::autopilot_system_id)(
       "heartbeat_period_s", &BridgeConfig::heartbeat_period_s)("link_timeout_s", &BridgeConfig::link_timeout_s)(
@@ -70,7 +69,7 @@ BridgeConfig load_bridge(const util::Config& cfg) {
       "extended_state_rate_hz", &BridgeConfig::extended_state_rate_hz)("battery_rate_hz", &BridgeConfig::battery_rate_hz)
       .known("landing_path")
       .finish();
-  path = cfg.get<std::string>("landing_path", path);
+  const std::string path = cfg.get<std::string>("landing_path", "aerie");
   if (path == "aerie")
     c.landing_path = LandingPath::Aerie;
   else if (path == "autopilot")
@@ -235,10 +234,10 @@ void AutopilotLink::on_heartbeat(const mav::Heartbeat& hb, const mav::Frame& f, 
   view_.mode = mav::mode_name(view_.autopilot, hb.custom_mode);
   view_.system_status = hb.system_status;
   view_.in_companion_mode = mav::in_companion_mode(view_.autopilot, hb.custom_mode);
-  if (!was_up) link_up(now_us);
+  if (!was_up) link_up();
 }
 
-void AutopilotLink::link_up(int64_t now_us) {
+void AutopilotLink::link_up() {
   view_.link = AutopilotView::Link::Ok;
   log(std::string("link up: ") + mav::to_string(view_.autopilot) + " autopilot, system " +
       std::to_string(view_.system_id) + " component " + std::to_string(view_.component_id) +
@@ -251,7 +250,6 @@ void AutopilotLink::link_up(int64_t now_us) {
   // (the command client keeps one command of an id in flight): the first now, the rest on later polls.
   for (const auto& [id, hz] : streams)
     if (hz > 0) pending_intervals_.push_back({id, hz});
-  (void)now_us;
 }
 
 void AutopilotLink::send_command(uint16_t command, std::array<float, 7> p, int64_t now_us) {
@@ -428,7 +426,7 @@ std::vector<std::vector<uint8_t>> AutopilotLink::poll(int64_t now_us) {
     ++counters_.link_losses;
     log("link LOST: no heartbeat from the autopilot for " + std::to_string(cfg_.link_timeout_s) + " s");
   } else if (view_.link == AutopilotView::Link::Lost && now_us - view_.last_heard_us <= 1'000'000) {
-    link_up(now_us);
+    link_up();
   }
   if (now_us - last_heartbeat_sent_ >= static_cast<int64_t>(cfg_.heartbeat_period_s * 1e6)) {
     mav::Heartbeat hb;

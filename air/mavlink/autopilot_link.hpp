@@ -192,7 +192,7 @@ class AutopilotLink {
   void on_heartbeat(const mavlink::Heartbeat& hb, const mavlink::Frame& f, int64_t now_us);
   void on_ack(const mavlink::CommandAck& ack, int64_t now_us);
   void on_statustext(const mavlink::Statustext& m);
-  void link_up(int64_t now_us);
+  void link_up();
   void send_command(uint16_t command, std::array<float, 7> params, int64_t now_us);
   void fly(int64_t now_us);  // the flight logic of the two landing paths, once per poll
   template <class Msg>
