@@ -30,6 +30,7 @@ SimLink::SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, c
                  const std::optional<SimDoor>& door)
     : air_(air), ground_(ground), down_(none_allowed(down)), up_(none_allowed(up)) {
   if (door) {
+    hooks_ = door;
     seal::OpenerConfig o;
     o.overlap_s = door->overlap_s;
     const seal::SecretKey* k = door->key.get();
@@ -51,8 +52,24 @@ SimLink::SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, c
     }, 100000);
 }
 
+bool SimLink::inject(bool down, std::span<const uint8_t> datagram) {
+  DoorEnds* d = down ? door_down_.get() : door_up_.get();
+  if (!d) throw std::logic_error("SimLink::inject: the link has no door");
+  const auto m = d->receiver.receive(datagram, static_cast<double>(now_us_) * 1e-6);
+  if (!m) return false;
+  bus::Bus& b = down ? ground_ : air_;
+  b.publish_raw(m->channel, m->payload.data(), static_cast<unsigned>(m->payload.size()));
+  ++injected_;
+  return true;
+}
+
 int SimLink::deliver() {
   int n = 0;
+  if (hooks_ && hooks_->on_deliver) {
+    const int before = injected_;
+    hooks_->on_deliver(*this, static_cast<double>(now_us_) * 1e-6);
+    n += injected_ - before;  // so that settle() handles them in this round
+  }
   for (Relay* r : {&down_, &up_}) {
     const Side to = r == &down_ ? Side::kGround : Side::kAir;
     bus::Bus& b = to == Side::kGround ? ground_ : air_;
@@ -66,11 +83,13 @@ int SimLink::deliver() {
       }
       // Sealed by the sending half, opened by the receiving one (refusals counted there).
       if (!d->sender.send(p.channel, p.data, t, datagrams_)) continue;
-      for (const auto& dg : datagrams_)
+      for (const auto& dg : datagrams_) {
+        if (hooks_->tap) hooks_->tap(r == &down_, dg, t);
         if (auto m = d->receiver.receive(dg, t)) {
           b.publish_raw(m->channel, m->payload.data(), static_cast<unsigned>(m->payload.size()));
           ++n;
         }
+      }
     }
   }
   return n;

@@ -13,6 +13,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
+#include <stdexcept>
 #include <string>
 
 #include "common/bus/bus.hpp"
@@ -31,12 +33,20 @@ const char* side_name(Side side);
 // half's DoorReceiver (policy: the direction's channels and `rates`), in process, with the
 // simulation's clock for rekeying -- what aerie-link --half does between the impairments and
 // the far network, without sockets.
+class SimLink;
+
 struct SimDoor {
   std::shared_ptr<const seal::SecretKey> key;  // null: insecure frames (still framed and checked)
   seal::RekeyPolicy rekey;                     // seconds of simulation time
   double overlap_s = 5.0;
   ReassemblyLimits limits;
   std::vector<RateRule> down_rates, up_rates;
+  // Test hooks (tests/tools/door/test_door_attacks.cpp): `tap` sees each datagram a sending
+  // half sealed (down: air->ground), before the far half opens it; `on_deliver` is called at
+  // the start of each SimLink::deliver(), where a test may SimLink::inject() what a third
+  // party puts on a receiving side.
+  std::function<void(bool down, std::span<const uint8_t> datagram, double now_s)> tap;
+  std::function<void(SimLink& link, double now_s)> on_deliver;
 };
 
 // Where each node runs, and the link between the two sides.
@@ -61,6 +71,11 @@ class SimLink {
   int deliver();
   // When the link next delivers (or sends) something; -1 when it is empty.
   int64_t next_event_us() const;
+  // A datagram from a third party on a direction's receiving side (down: the ground half's),
+  // opened now by that half's DoorReceiver like any other; published on its bus only if it
+  // opens and passes the policy. Returns whether it was published. Throws std::logic_error
+  // without a door.
+  bool inject(bool down, std::span<const uint8_t> datagram);
 
   Relay& down() { return down_; }
   Relay& up() { return up_; }
@@ -74,6 +89,8 @@ class SimLink {
  private:
   bus::Bus &air_, &ground_;
   Relay down_, up_;
+  std::optional<SimDoor> hooks_;  // the door's tap and on_deliver
+  int injected_ = 0;              // injected datagrams published (deliver() counts them)
   std::unique_ptr<DoorEnds> door_down_, door_up_;
   std::vector<std::vector<uint8_t>> datagrams_;
   int64_t now_us_ = 0;
