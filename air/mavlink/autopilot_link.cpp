@@ -177,8 +177,13 @@ void AutopilotLink::on_frame(const mav::Frame& f, int64_t now_us) {
           const Eigen::Quaterniond q(m.q1, m.q2, m.q3, m.q4);  // body FRD -> NED
           if (q.coeffs().allFinite() && std::abs(q.norm() - 1) < 1e-3) attitude_ned_ = q.normalized();
         } else if constexpr (std::is_same_v<M, mav::LocalPositionNed>) {
-          if (attitude_ned_ && std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.z))
+          if (attitude_ned_ && std::isfinite(m.x) && std::isfinite(m.y) && std::isfinite(m.z)) {
             view_.pose = VehicleNed{Eigen::Vector3d(m.x, m.y, m.z), *attitude_ned_};
+            view_.velocity_ned = Eigen::Vector3d(m.vx, m.vy, m.vz);
+          }
+        } else if constexpr (std::is_same_v<M, mav::EstimatorStatus>) {
+          if (m.flags != view_.estimator_flags) changed_ = true;
+          view_.estimator_flags = m.flags;
         } else if constexpr (std::is_same_v<M, mav::HighresImu>) {
           AutopilotImu s;
           s.utime = now_us;

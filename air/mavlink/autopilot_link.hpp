@@ -128,6 +128,8 @@ struct AutopilotView {
   std::string last_statustext, last_command, last_result;
   int64_t last_heard_us = 0;  // local time of the newest frame from the autopilot
   std::optional<VehicleNed> pose;  // from LOCAL_POSITION_NED + ATTITUDE_QUATERNION
+  Eigen::Vector3d velocity_ned = Eigen::Vector3d::Zero();  // LOCAL_POSITION_NED's
+  int estimator_flags = -1;        // ESTIMATOR_STATUS.flags; -1 before the first
 };
 
 struct BridgeCounters {

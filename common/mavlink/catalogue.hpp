@@ -521,6 +521,29 @@ struct MessageInterval {
   }
 };
 
+struct EstimatorStatus {
+  static constexpr uint32_t kId = 230;
+  static constexpr std::string_view kName = "ESTIMATOR_STATUS";
+  uint64_t time_usec = 0;
+  uint16_t flags = 0;  // ESTIMATOR_STATUS_FLAGS
+  float vel_ratio = 0;
+  float pos_horiz_ratio = 0;
+  float pos_vert_ratio = 0;
+  float mag_ratio = 0;
+  float hagl_ratio = 0;
+  float tas_ratio = 0;
+  float pos_horiz_accuracy = 0;
+  float pos_vert_accuracy = 0;
+  static constexpr auto fields() {
+    using S = EstimatorStatus;
+    return std::tuple{field("time_usec", &S::time_usec), field("flags", &S::flags), field("vel_ratio", &S::vel_ratio),
+                      field("pos_horiz_ratio", &S::pos_horiz_ratio), field("pos_vert_ratio", &S::pos_vert_ratio),
+                      field("mag_ratio", &S::mag_ratio), field("hagl_ratio", &S::hagl_ratio),
+                      field("tas_ratio", &S::tas_ratio), field("pos_horiz_accuracy", &S::pos_horiz_accuracy),
+                      field("pos_vert_accuracy", &S::pos_vert_accuracy)};
+  }
+};
+
 struct ExtendedSysState {
   static constexpr uint32_t kId = 245;
   static constexpr std::string_view kName = "EXTENDED_SYS_STATE";
@@ -598,7 +621,8 @@ using Message = std::variant<Heartbeat, SysStatus, SystemTime, ParamRequestRead,
                              AttitudeQuaternion, LocalPositionNed, SetGpsGlobalOrigin, GpsGlobalOrigin, CommandLong,
                              CommandAck, SetPositionTargetLocalNed, PositionTargetLocalNed, VisionPositionEstimate,
                              HighresImu, RadioStatus, Timesync, DistanceSensor, BatteryStatus, AutopilotVersion,
-                             LandingTarget, MessageInterval, ExtendedSysState, Statustext, SetupSigning, Odometry>;
+                             LandingTarget, MessageInterval, EstimatorStatus, ExtendedSysState, Statustext, SetupSigning,
+                             Odometry>;
 
 // What a parser needs to check a frame of a message id.
 struct MessageInfo {

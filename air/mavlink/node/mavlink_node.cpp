@@ -196,6 +196,21 @@ aerie::autopilot_state_t MavlinkNode::state_message(int64_t now_us) const {
   m.battery_remaining_pct = v.battery_remaining_pct;
   m.link_quality = v.link_quality;
   m.clock_offset_us = v.clock_offset_us;
+  m.estimator_flags = v.estimator_flags;
+  m.local_position_valid = v.pose.has_value();
+  if (v.pose) {
+    for (int k = 0; k < 3; ++k) {
+      m.position_ned[k] = static_cast<float>(v.pose->position[k]);
+      m.velocity_ned[k] = static_cast<float>(v.velocity_ned[k]);
+    }
+    const Eigen::Quaterniond& q = v.pose->attitude;
+    m.attitude[0] = static_cast<float>(q.w());
+    m.attitude[1] = static_cast<float>(q.x());
+    m.attitude[2] = static_cast<float>(q.y());
+    m.attitude[3] = static_cast<float>(q.z());
+  } else {
+    m.attitude[0] = 1;
+  }
   m.last_statustext = v.last_statustext;
   m.last_command = v.last_command;
   m.last_result = v.last_result;

@@ -72,6 +72,31 @@ TEST(MavlinkNode, RoutesTheAutopilotToTheGroundStationAndOnlyWholeFramesBack) {
   EXPECT_EQ(r.states.back().mode, "OFFBOARD");
   EXPECT_TRUE(r.states.back().armed);
   EXPECT_TRUE(r.states.back().aerie_in_control);
+  EXPECT_EQ(r.states.back().estimator_flags, -1);  // none heard yet
+  EXPECT_FALSE(r.states.back().local_position_valid);
+
+  // The autopilot's estimate reaches AUTOPILOT_STATE: its flags, local position and attitude.
+  mav::AttitudeQuaternion att;
+  att.q1 = 1;
+  mav::LocalPositionNed lp;
+  lp.x = 1.5f;
+  lp.z = -2.0f;
+  lp.vy = 0.25f;
+  mav::EstimatorStatus est;
+  est.flags = 0x0433;  // attitude, velocity, positions: what EKF2 reports when it is healthy
+  std::vector<uint8_t> more = mav::encode(att, {1, 1, 1});
+  for (const auto& f : {mav::encode(lp, {1, 1, 2}), mav::encode(est, {1, 1, 3})}) more.insert(more.end(), f.begin(), f.end());
+  r.autopilot->write(more);
+  r.node->step();
+  r.settle();
+  const auto& st = r.states.back();
+  EXPECT_EQ(st.estimator_flags, 0x0433);
+  ASSERT_TRUE(st.local_position_valid);
+  EXPECT_FLOAT_EQ(st.position_ned[0], 1.5f);
+  EXPECT_FLOAT_EQ(st.position_ned[2], -2.0f);
+  EXPECT_FLOAT_EQ(st.velocity_ned[1], 0.25f);
+  EXPECT_FLOAT_EQ(st.attitude[0], 1.0f);
+  r.gcs->read(down);  // routed to the ground station too
 
   // The ground station's command reaches the autopilot whole; the garbage around it does not.
   mav::CommandLong cmd;
