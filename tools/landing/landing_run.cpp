@@ -80,7 +80,7 @@ class MavlinkPath {
     const double t = sim_.time();
     face_.receive(in, t);
     const auto out = face_.step(t, sim_.vehicle().state());
-    sim_.command(command_input(out.command));
+    sim_.command(sim::autopilot::command_input(out.command));
     vehicle_->write(out.bytes);
     node_->step();
   }
@@ -100,15 +100,6 @@ class MavlinkPath {
   }
 
  private:
-  static sim::CommandInput command_input(const sim::AutopilotCommand& c) {
-    using Mode = sim::AutopilotCommand::Mode;
-    sim::CommandInput in;  // control_cmd_t's modes, as FlightSim takes them
-    in.mode = c.mode == Mode::Velocity ? 1 : c.mode == Mode::Takeoff ? 3 : c.mode == Mode::Land ? 4 : 0;
-    in.velocity = {c.velocity.x(), c.velocity.y(), c.velocity.z()};
-    in.yaw_rate_deg_s = c.yaw_rate_deg_s;
-    return in;
-  }
-
   sim::FlightSim& sim_;
   sim::autopilot::MavlinkFace face_;
   std::unique_ptr<mavlink::Endpoint> vehicle_;

@@ -6,6 +6,15 @@
 
 namespace aerie::sim::autopilot {
 
+CommandInput command_input(const AutopilotCommand& c) {
+  using Mode = AutopilotCommand::Mode;
+  CommandInput in;
+  in.mode = c.mode == Mode::Velocity ? 1 : c.mode == Mode::Takeoff ? 3 : c.mode == Mode::Land ? 4 : 0;
+  in.velocity = {c.velocity.x(), c.velocity.y(), c.velocity.z()};
+  in.yaw_rate_deg_s = c.yaw_rate_deg_s;
+  return in;
+}
+
 MavlinkFace::MavlinkFace(Personality personality, const Params& params) : ap_(personality, params) {}
 
 void MavlinkFace::enable_signing(const mavlink::Key& key, mavlink::SigningClock clock) {

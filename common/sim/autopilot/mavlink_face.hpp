@@ -13,8 +13,12 @@
 #include "common/mavlink/parser.hpp"
 #include "common/mavlink/signing.hpp"
 #include "common/sim/autopilot/sim_autopilot.hpp"
+#include "common/sim/flight/flight_sim.hpp"
 
 namespace aerie::sim::autopilot {
+
+// The autopilot's command as FlightSim::command takes it (control_cmd_t's modes).
+CommandInput command_input(const AutopilotCommand& c);
 
 class MavlinkFace {
  public:

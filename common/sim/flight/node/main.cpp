@@ -99,13 +99,7 @@ int main(int argc, char** argv) {
       endpoint->read(bytes);
       face->receive(bytes, simulator.time());
       const auto out = face->step(simulator.time(), simulator.vehicle().state());
-      sim::CommandInput in;
-      using Mode = sim::AutopilotCommand::Mode;
-      in.mode = out.command.mode == Mode::Velocity ? 1 : out.command.mode == Mode::Takeoff ? 3
-                : out.command.mode == Mode::Land   ? 4 : 0;
-      in.velocity = {out.command.velocity.x(), out.command.velocity.y(), out.command.velocity.z()};
-      in.yaw_rate_deg_s = out.command.yaw_rate_deg_s;
-      simulator.command(in);
+      simulator.command(sim::autopilot::command_input(out.command));
       if (!out.bytes.empty()) endpoint->write(out.bytes);
     };
     bus::install_stop_handlers();
