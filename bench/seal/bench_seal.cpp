@@ -1,7 +1,8 @@
 // Micro-benchmarks of the sealed door (common/seal): seal and open one datagram at 64 B, 1 kB
 // and 64 kB (64,000 B) payloads, and a 752x480 stereo pair (2 x 360,960 bytes of GRAY8) split into
 // datagrams of at most 60 kB, as the link's halves would send it. CPU ns per datagram (time/
-// items) and MB/s (bytes_per_second) of payload, on one core.
+// items) and MB/s (bytes_per_second) of payload, on one core; and the operator's signature on a
+// command, signed and verified.
 //   aerie-bench-seal [--benchmark_filter=...] [--benchmark_format=json]
 #include <benchmark/benchmark.h>
 
@@ -9,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "common/seal/operator.hpp"
 #include "common/seal/seal.hpp"
 
 namespace {
@@ -100,6 +102,44 @@ void BM_StereoPairSealOpen(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(kStereoPair));
 }
 BENCHMARK(BM_StereoPairSealOpen);
+
+// The operator's signature on one 100-byte command (common/seal/operator.hpp): the ground
+// half's signing and the air half's check (Ed25519), per command.
+void BM_CommandSign(benchmark::State& state) {
+  const auto p = payload(100);
+  const Session session = new_session();
+  CommandSigner signer(OperatorKey::generate());
+  for (auto _ : state) benchmark::DoNotOptimize(signer.sign(session, "PILOT_CMD", p));
+  state.SetItemsProcessed(state.iterations());
+  per_datagram(state, state.iterations());
+}
+BENCHMARK(BM_CommandSign);
+
+void BM_CommandVerify(benchmark::State& state) {
+  const auto p = payload(100);
+  const Session session = new_session();
+  CommandSigner signer(OperatorKey::generate());
+  CommandVerifier verifier({signer.public_key()}, session);
+  // Distinct counters, as a stream of commands has: each verifies once.
+  std::vector<std::vector<uint8_t>> envelopes;
+  for (int i = 0; i < 4096; ++i) envelopes.push_back(signer.sign(session, "PILOT_CMD", p));
+  std::span<const uint8_t> body;
+  std::string why;
+  size_t i = 0;
+  for (auto _ : state) {
+    if (i == envelopes.size()) {  // a new session: the counters are fresh again
+      state.PauseTiming();
+      verifier = CommandVerifier({signer.public_key()}, new_session());
+      for (auto& e : envelopes) e = signer.sign(verifier.session(), "PILOT_CMD", p);
+      i = 0;
+      state.ResumeTiming();
+    }
+    if (verifier.verify("PILOT_CMD", envelopes[i++], body, why) != CommandRefusal::None) state.SkipWithError(why.c_str());
+  }
+  state.SetItemsProcessed(state.iterations());
+  per_datagram(state, state.iterations());
+}
+BENCHMARK(BM_CommandVerify);
 
 }  // namespace
 

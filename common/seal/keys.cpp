@@ -78,11 +78,13 @@ void save_key(const std::string& path, const SecretKey& key, bool overwrite) {
   sodium_memzero(bytes.data(), bytes.size());
 }
 
-std::string fingerprint(const SecretKey& key) {
+std::string fingerprint(const SecretKey& key) { return fingerprint(std::span<const uint8_t>(key.data(), key.size())); }
+
+std::string fingerprint(std::span<const uint8_t> bytes) {
   init_sodium();
   uint8_t personal[crypto_generichash_blake2b_PERSONALBYTES] = {'a', 'e', 'r', 'i', 'e', '-', 'f', 'p'};
   uint8_t hash[crypto_generichash_blake2b_BYTES_MIN];  // 16 bytes, the shortest BLAKE2b libsodium gives
-  crypto_generichash_blake2b_salt_personal(hash, sizeof hash, key.data(), key.size(), nullptr, 0, nullptr,
+  crypto_generichash_blake2b_salt_personal(hash, sizeof hash, bytes.data(), bytes.size(), nullptr, 0, nullptr,
                                            personal);
   std::string out;
   char hex[3];

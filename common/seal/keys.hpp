@@ -51,5 +51,7 @@ void save_key(const std::string& path, const SecretKey& key, bool overwrite = fa
 // BLAKE2b-128(key, personal "aerie-fp"), so that both halves' status can be compared without
 // showing the key. It reveals nothing usable about the key (a preimage of BLAKE2b).
 std::string fingerprint(const SecretKey& key);
+// The same name of any bytes (an operator's public key, operator.hpp).
+std::string fingerprint(std::span<const uint8_t> bytes);
 
 }  // namespace aerie::seal

@@ -21,7 +21,8 @@ std::string octal_mode(mode_t mode) {
 }
 }  // namespace
 
-std::vector<uint8_t> read_key_file(const std::string& path, size_t expected_size, const std::string& what) {
+std::vector<uint8_t> read_key_file(const std::string& path, size_t expected_size, const std::string& what,
+                                   KeyFile kind) {
   require_regular_file(path, what);
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
   if (fd < 0) throw std::runtime_error(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
@@ -30,10 +31,15 @@ std::vector<uint8_t> read_key_file(const std::string& path, size_t expected_size
     ::close(fd);
     throw std::runtime_error(path + ": cannot stat " + what);
   }
-  if ((st.st_mode & 077) != 0) {
+  if (kind == KeyFile::Secret && (st.st_mode & 077) != 0) {
     ::close(fd);
     throw std::runtime_error(path + ": " + what + " is readable or writable by others (mode " +
                              octal_mode(st.st_mode) + "); chmod 600 " + path);
+  }
+  if (kind == KeyFile::Public && (st.st_mode & 022) != 0) {
+    ::close(fd);
+    throw std::runtime_error(path + ": " + what + " is writable by others (mode " + octal_mode(st.st_mode) +
+                             "); chmod 644 " + path);
   }
   if (static_cast<size_t>(st.st_size) != expected_size) {
     ::close(fd);
@@ -56,12 +62,13 @@ std::vector<uint8_t> read_key_file(const std::string& path, size_t expected_size
 }
 
 void write_key_file(const std::string& path, const std::vector<uint8_t>& bytes, bool overwrite,
-                       const std::string& what) {
+                    const std::string& what, KeyFile kind) {
   if (!overwrite && ::access(path.c_str(), F_OK) == 0)
     throw std::runtime_error(path + ": " + what + " exists already (refusing to overwrite it)");
   const std::string tmp = path + ".part";
   ::unlink(tmp.c_str());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
+  if (fd >= 0 && kind == KeyFile::Public) ::fchmod(fd, 0644);  // past the umask: a public key is read by others
   if (fd < 0) throw std::runtime_error(path + ": cannot create " + what + " (" + std::strerror(errno) + ")");
   size_t put = 0;
   while (put < bytes.size()) {

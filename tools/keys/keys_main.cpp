@@ -3,6 +3,7 @@
 //   aerie-keys generate --out FILE [--force]
 //   aerie-keys fingerprint FILE
 //   aerie-keys rotate FILE [--force]
+//   aerie-keys operator --out FILE [--force]      (FILE and FILE.pub: the operator's signing key)
 // Exit status: 0 done, 1 an error (named on stderr), CLI11's code for a wrong option.
 #include <CLI/CLI.hpp>
 
@@ -10,9 +11,12 @@
 #include <stdexcept>
 
 #include "common/seal/keys.hpp"
+#include "common/seal/operator.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Make, compare and rotate the mission key that seals the air-ground link", "aerie-keys"};
+  CLI::App app{"Make, compare and rotate the mission key that seals the air-ground link, and the operator's key "
+               "that signs commands",
+               "aerie-keys"};
   app.require_subcommand(1);
   app.footer("A mission key file holds 32 random bytes with mode 0600; both link halves need the same file. "
              "Compare the fingerprints the halves show, never the keys.");
@@ -25,13 +29,24 @@ int main(int argc, char** argv) {
 
   auto* fp = app.add_subcommand("fingerprint", "Print a key file's fingerprint (the first 8 bytes of its BLAKE2b "
                                                "hash), to compare the two halves' keys");
-  fp->add_option("file", file, "Mission key file")->required();
+  fp->add_option("file", file, "Mission key file, or an operator's FILE.pub")->required();
+  bool operator_key = false;
+  fp->add_flag("--operator", operator_key,
+               "FILE is an operator key (its public key's fingerprint is printed; implied for FILE.pub)");
 
   auto* rot = app.add_subcommand("rotate", "Replace a key file by a new random key, keeping the old one as FILE.old "
                                            "(mode 0600); prints both fingerprints");
   rot->add_option("file", file, "Mission key file to rotate")->required();
   rot->add_flag("--force", force, "Replace an existing FILE.old (refused otherwise)");
   rot->footer("Copy the new key to the other half, then restart both halves; FILE.old lets you go back.");
+
+  auto* op = app.add_subcommand("operator", "Write a new operator key: FILE (the Ed25519 seed, mode 0600, for the "
+                                            "ground half's --operator-key) and FILE.pub (for the air half's "
+                                            "--operator-pub); prints the public key's fingerprint");
+  op->add_option("--out", out, "Operator key file to write (FILE.pub beside it)")->required();
+  op->add_flag("--force", force, "Replace existing files (refused otherwise)");
+  op->footer("One operator key per ground station that may command; a station without one only watches. "
+             "Copy FILE.pub to the vehicle, never FILE.");
 
   try {
     app.parse(argc, argv);
@@ -45,7 +60,16 @@ int main(int argc, char** argv) {
       save_key(out, key, force);
       std::cout << "wrote mission key " << out << " (mode 0600)\nfingerprint " << fingerprint(key) << "\n";
     } else if (*fp) {
-      std::cout << fingerprint(load_key(file)) << "\n";
+      const bool pub = file.size() > 4 && file.compare(file.size() - 4, 4, ".pub") == 0;
+      if (pub) std::cout << OperatorPublicKey::load(file).fingerprint() << "\n";
+      else if (operator_key) std::cout << OperatorKey::load(file).public_key().fingerprint() << "\n";
+      else std::cout << fingerprint(load_key(file)) << "\n";
+    } else if (*op) {
+      const OperatorKey key = OperatorKey::generate();
+      key.save(out, force);
+      key.public_key().save(out + ".pub", force);
+      std::cout << "wrote operator key " << out << " (mode 0600) and " << out << ".pub\npublic key fingerprint "
+                << key.public_key().fingerprint() << "\n";
     } else if (*rot) {
       const SecretKey old_key = load_key(file);
       const SecretKey new_key = SecretKey::generate();
