@@ -7,7 +7,8 @@
 # unicast: the nodes' namespace has no interface but loopback.
 #
 #   sudo scripts/air-netns.sh up --radio wlan0        # namespaces; wlan0 moves into the radio one
-#   sudo scripts/air-netns.sh door -- --key /etc/aerie/mission.key --listen 10.0.0.1:17200 --peer 10.0.0.2:17200
+#   sudo scripts/air-netns.sh door -- --key /etc/aerie/mission.key --operator-pub /etc/aerie/operator.key.pub \
+#                                     --listen 10.0.0.1:17200 --peer 10.0.0.2:17200
 #   sudo scripts/air-netns.sh nodes -- aerie-deputy --name air      # any air node (procman's deputy, ...)
 #   sudo scripts/air-netns.sh check                   # refuses a topology that is not one door
 #   sudo scripts/air-netns.sh down                    # the radio back to the host, namespaces removed
@@ -17,7 +18,7 @@
 set -euo pipefail
 
 usage() {
-  sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'
   cat <<EOF
 Options (before the command's own arguments):
   --nodes-ns NAME   the air nodes' namespace (default: aerie-air)

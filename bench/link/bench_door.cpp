@@ -86,7 +86,7 @@ InProcess cost(size_t size, const seal::SecretKey& key) {
   for (int secure = 0; secure < 2; ++secure) {
     const seal::SecretKey* k = secure ? &key : nullptr;
     link::DoorSender tx(k, seal::Direction::AirToGround, 1, 0, 0);
-    link::DoorReceiver rx(k, seal::Direction::AirToGround, link::DoorPolicy{".*", {}});
+    link::DoorReceiver rx(k, seal::Direction::AirToGround, link::DoorPolicy{".*", {}, ""});
     std::vector<std::vector<std::vector<uint8_t>>> all(static_cast<size_t>(n));
     double t0 = thread_cpu_s();
     for (int i = 0; i < n; ++i) tx.send("CAM_STEREO", payload, i * 1e-3, all[static_cast<size_t>(i)]);
@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
   seal::save_key(key_file, key);
   const std::string cfg = out_dir + "/door.yaml";
   std::ofstream(cfg) << "air_to_ground: {channels: \"PROBE.*\", queue_bytes: 100000000, rate: []}\n"
-                     << "ground_to_air: {channels: \"PROBE_UP\", rate: []}\n";
+                     << "ground_to_air: {channels: \"PROBE_UP\", rate: [], operator_channels: \"\"}\n";
 
   std::optional<testbed::RealtimePriority> rt;
   if (realtime) rt.emplace(10);

@@ -29,7 +29,7 @@
 // In this mode a datagram opens only if one of the input's senders sealed it, and only once.
 // Checked on every datagram: receive() never throws; counted exactly once (datagrams +1; at most
 // one of delivered / not_allowed / rate_limited / malformed / insecure_peer / secure_peer /
-// opener refusal, and none only for a fragment kept or dropped with its message; secure: opened
+// too_large / hellos / a command refusal / opener refusal, and none only for a fragment kept or dropped with its message; secure: opened
 // + refused + insecure_peer +1); a refusal says why(); a delivery is counted with its bytes, on a
 // channel the policy allows (its regex read here, not the door's matcher), at most
 // max_message_bytes, and only from an opened datagram; at most max_pending_messages + 1
@@ -129,8 +129,10 @@ struct Outcome {
 };
 
 uint64_t own_outcomes(const link::ReceiverCounters& c) {
-  return c.delivered + c.not_allowed + c.rate_limited + c.malformed + c.insecure_peer + c.secure_peer +
-         c.opener.refused_total();
+  uint64_t commands = 0;  // the operator's signature (ground -> air only: never in this air -> ground target)
+  for (const uint64_t n : c.commands_refused) commands += n;
+  return c.delivered + c.not_allowed + c.rate_limited + c.malformed + c.insecure_peer + c.secure_peer + c.too_large +
+         c.hellos + commands + c.opener.refused_total();
 }
 
 // One datagram through the receiver, with the checks every datagram gets.

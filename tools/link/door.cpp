@@ -147,11 +147,51 @@ void DoorSender::emit(std::string_view channel, std::span<const uint8_t> frame, 
   counters_.bytes += out.size();
 }
 
+void DoorSender::sign_commands(const std::string& operator_channels, std::optional<seal::CommandSigner> signer) {
+  operator_channels_ = ChannelMatcher(operator_channels);
+  signer_.reset();
+  if (signer) signer_.emplace(std::move(*signer));
+}
+
+bool DoorSender::emit_hello(std::span<const uint8_t> body, double now_s, std::vector<uint8_t>& out) {
+  if (!sealer_) return false;
+  frame_.resize(1 + body.size());
+  frame_[0] = 2;
+  if (!body.empty()) std::memcpy(frame_.data() + 1, body.data(), body.size());
+  emit(kHelloChannel, frame_, now_s, out);
+  ++counters_.hellos;
+  return true;
+}
+
+bool DoorSender::hello(const seal::Session& session, double now_s, std::vector<uint8_t>& out) {
+  return emit_hello(session, now_s, out);
+}
+
+bool DoorSender::hello_request(double now_s, std::vector<uint8_t>& out) { return emit_hello({}, now_s, out); }
+
 bool DoorSender::send(std::string_view channel, std::span<const uint8_t> payload, double now_s,
                       std::vector<std::vector<uint8_t>>& out) {
   if (!seal::valid_channel(channel))
     throw std::invalid_argument("door: channel '" + std::string(channel) + "' is not a valid channel name");
   out.clear();
+  if (sealer_ && operator_channels_(std::string(channel))) {
+    if (!signer_) {
+      ++counters_.unsigned_commands;
+      return false;
+    }
+    if (!session_) {
+      ++counters_.no_session;
+      return false;
+    }
+    const std::vector<uint8_t> envelope = signer_->sign(*session_, channel, payload);
+    ++counters_.signed_commands;
+    return split(channel, envelope, now_s, out);
+  }
+  return split(channel, payload, now_s, out);
+}
+
+bool DoorSender::split(std::string_view channel, std::span<const uint8_t> payload, double now_s,
+                       std::vector<std::vector<uint8_t>>& out) {
   if (payload.size() > limits_.max_message_bytes) {
     ++counters_.too_large;
     return false;
@@ -195,7 +235,11 @@ bool DoorSender::send(std::string_view channel, std::span<const uint8_t> payload
 
 DoorReceiver::DoorReceiver(const seal::SecretKey* key, seal::Direction direction, DoorPolicy policy,
                            seal::OpenerConfig opener, ReassemblyLimits limits)
-    : direction_(direction), allowed_(policy.channels), rates_(std::move(policy.rates)), limits_(limits) {
+    : direction_(direction),
+      allowed_(policy.channels),
+      operator_channels_(direction == seal::Direction::GroundToAir ? policy.operator_channels : std::string()),
+      rates_(std::move(policy.rates)),
+      limits_(limits) {
   limits_.validate();
   opener.direction = direction;
   if (key) opener_.emplace(*key, opener);
@@ -264,8 +308,12 @@ std::optional<Delivered> DoorReceiver::receive(std::span<const uint8_t> d, doubl
 std::optional<Delivered> DoorReceiver::on_frame(uint32_t sender, std::string_view channel_view,
                                                 std::span<const uint8_t> f, double now_s) {
   std::string channel(channel_view);
-  if (f.empty() || f[0] > 1) {
+  if (f.empty() || f[0] > 2) {
     refuse(counters_.malformed, "frame kind missing or unknown");
+    return std::nullopt;
+  }
+  if (f[0] == 2) {
+    on_hello(channel, f);
     return std::nullopt;
   }
   if (f[0] == 1) ++counters_.fragments;
@@ -274,7 +322,14 @@ std::optional<Delivered> DoorReceiver::on_frame(uint32_t sender, std::string_vie
     refuse(counters_.not_allowed, channel + " may not cross " + direction_key(direction_));
     return std::nullopt;
   }
-  if (f[0] == 0) return admit(std::move(channel), std::vector<uint8_t>(f.begin() + 1, f.end()), now_s);
+  if (f[0] == 0) {
+    if (f.size() - kWholeHeader > limits_.max_message_bytes) {
+      refuse(counters_.too_large, channel + ": message of " + std::to_string(f.size() - kWholeHeader) +
+                                      " bytes over max_message_bytes");
+      return std::nullopt;
+    }
+    return admit(std::move(channel), std::vector<uint8_t>(f.begin() + 1, f.end()), now_s);
+  }
 
   if (f.size() < kFragmentHeader) {
     refuse(counters_.malformed, "fragment header truncated");
@@ -290,7 +345,7 @@ std::optional<Delivered> DoorReceiver::on_frame(uint32_t sender, std::string_vie
     return std::nullopt;
   }
   if (total > limits_.max_message_bytes) {
-    refuse(counters_.reassembly_dropped, "message of " + std::to_string(total) + " bytes over max_message_bytes");
+    refuse(counters_.too_large, channel + ": message of " + std::to_string(total) + " bytes over max_message_bytes");
     return std::nullopt;
   }
   const uint64_t key = (uint64_t{sender} << 32) | id;
@@ -338,7 +393,45 @@ std::optional<Delivered> DoorReceiver::on_frame(uint32_t sender, std::string_vie
   return admit(std::move(channel), std::move(data), now_s);
 }
 
+bool DoorReceiver::on_hello(const std::string& channel, std::span<const uint8_t> f) {
+  // Sealed only, on the reserved channel: the air half's session down, a request for it up.
+  if (opener_ && channel == kHelloChannel) {
+    if (direction_ == seal::Direction::AirToGround && f.size() == 1 + seal::kSessionSize) {
+      seal::Session s;
+      std::memcpy(s.data(), f.data() + 1, s.size());
+      peer_session_ = s;
+      ++counters_.hellos;
+      return true;
+    }
+    if (direction_ == seal::Direction::GroundToAir && f.size() == 1) {
+      hello_wanted_ = true;
+      ++counters_.hellos;
+      return true;
+    }
+  }
+  return refuse(counters_.malformed, "a hello that is not a sealed session announcement (down) or request (up)");
+}
+
 std::optional<Delivered> DoorReceiver::admit(std::string channel, std::vector<uint8_t> payload, double now_s) {
+  // The operator's signature before the rates: a forged command spends none of the operator's budget.
+  if (opener_ && operator_channels_(channel)) {
+    if (!verifier_) {
+      ++counters_.commands_refused[static_cast<size_t>(seal::CommandRefusal::Unsigned)];
+      why_ = channel + ": an operator's command, and this half has no operator public key to check it";
+      return std::nullopt;
+    }
+    std::span<const uint8_t> body;
+    std::string why;
+    const seal::CommandRefusal r = verifier_->verify(channel, payload, body, why);
+    if (r != seal::CommandRefusal::None) {
+      ++counters_.commands_refused[static_cast<size_t>(r)];
+      if (r == seal::CommandRefusal::OtherSession) hello_wanted_ = true;  // the ground half missed a restart
+      why_ = std::string(seal::to_string(r)) + ": " + why;
+      return std::nullopt;
+    }
+    ++counters_.commands_verified;
+    payload = std::vector<uint8_t>(body.begin(), body.end());
+  }
   if (!rates_.admit(channel, payload.size(), now_s)) {
     refuse(counters_.rate_limited, channel + " over its rate limit");
     return std::nullopt;

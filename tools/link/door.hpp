@@ -10,6 +10,10 @@
 //   whole:    1.. the message
 //   fragment: 1..4 message id (u32, per sender), 5..6 index (u16), 7..8 count (u16),
 //             9..12 total size (u32), 13..16 offset (u32), 17.. the fragment's bytes
+//   hello:    kind 2, sealed only, on the reserved channel kHelloChannel. Air -> ground: 1..16
+//             the air half's session (common/seal/operator.hpp), for which the ground half signs
+//             the operator's commands; ground -> air, empty: a request for it (a ground half that
+//             has none, or whose commands were refused for another session)
 // Integers little-endian. A message that does not fit one datagram is cut into fragments,
 // each sealed on its own, and reassembled by the receiver in a bounded buffer
 // (ReassemblyLimits); a message over max_message_bytes is refused at the sender and counted.
@@ -24,8 +28,10 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
+#include "common/seal/operator.hpp"
 #include "common/seal/seal.hpp"
 #include "tools/link/relay.hpp"
 
@@ -35,6 +41,7 @@ inline constexpr uint8_t kInsecureMagic = 0xA1;
 inline constexpr uint8_t kInsecureVersion = 1;
 inline constexpr size_t kWholeHeader = 1;
 inline constexpr size_t kFragmentHeader = 17;
+inline constexpr char kHelloChannel[] = "#hello";  // never an LCM channel ('#' starts none of Aerie's)
 
 enum class Half { kAir, kGround };
 Half half_from_name(const std::string& name);  // air | ground; throws std::invalid_argument naming it
@@ -85,11 +92,17 @@ class RateLimiter {
   std::map<std::string, Buckets> channels_;
 };
 
-// What may cross one direction: the channels (regex, whole names; "" = nothing) and their rates.
+// What may cross one direction: the channels (regex, whole names; "" = nothing), their rates,
+// and the operator's channels (regex; "" = none): commands that must also carry the operator's
+// signature (common/seal/operator.hpp) -- checked on ground -> air only, by a secure half.
 struct DoorPolicy {
   std::string channels;
   std::vector<RateRule> rates;
+  std::string operator_channels;
 };
+// The operator's commands, as config/link.yaml names them by default.
+inline constexpr char kDefaultOperatorChannels[] =
+    "PILOT_CMD|TRACK_CMD|FLC_PARAMS|MAP_CMD|PMD_ORDERS2|PMD_ORDERS2_SEALED";
 
 struct ReassemblyLimits {
   size_t max_message_bytes = 8u << 20;   // a larger message is refused (sender) / dropped (receiver)
@@ -107,6 +120,10 @@ struct SenderCounters {
   uint64_t fragments = 0;   // of which fragments
   uint64_t bytes = 0;       // datagram bytes
   uint64_t too_large = 0;   // refused: over max_message_bytes
+  uint64_t signed_commands = 0;    // operator's commands signed for the air half's session
+  uint64_t unsigned_commands = 0;  // refused: an operator's channel, and this half has no operator key
+  uint64_t no_session = 0;         // refused: an operator's command before the air half's first hello
+  uint64_t hellos = 0;             // sessions announced (air half) or asked for (ground half)
 };
 
 class DoorSender {
@@ -118,6 +135,16 @@ class DoorSender {
   // message is over max_message_bytes; throws std::invalid_argument for an invalid channel.
   bool send(std::string_view channel, std::span<const uint8_t> payload, double now_s,
             std::vector<std::vector<uint8_t>>& out);
+  // The ground half: messages on `operator_channels` (regex) are signed with `signer` for the
+  // air half's session (set_session); without a signer they are refused and counted. Only a
+  // secure sender signs (an insecure door authenticates nothing).
+  void sign_commands(const std::string& operator_channels, std::optional<seal::CommandSigner> signer);
+  void set_session(const seal::Session& session) { session_ = session; }
+  bool has_session() const { return session_.has_value(); }
+  // The air half: the datagram announcing its session (secure only; false when insecure).
+  bool hello(const seal::Session& session, double now_s, std::vector<uint8_t>& out);
+  // The ground half: the datagram asking for it (secure only).
+  bool hello_request(double now_s, std::vector<uint8_t>& out);
 
   bool secure() const { return sealer_.has_value(); }
   uint32_t epoch() const { return sealer_ ? sealer_->epoch() : 0; }
@@ -129,11 +156,18 @@ class DoorSender {
  private:
   void emit(std::string_view channel, std::span<const uint8_t> frame, double now_s, std::vector<uint8_t>& out);
 
+  bool emit_hello(std::span<const uint8_t> body, double now_s, std::vector<uint8_t>& out);
+  bool split(std::string_view channel, std::span<const uint8_t> payload, double now_s,
+             std::vector<std::vector<uint8_t>>& out);
+
   std::optional<seal::Sealer> sealer_;
   seal::Direction direction_;
   ReassemblyLimits limits_;
   uint32_t next_message_ = 1;
   std::vector<uint8_t> frame_;
+  ChannelMatcher operator_channels_{""};
+  std::optional<seal::CommandSigner> signer_;
+  std::optional<seal::Session> session_;
   SenderCounters counters_;
 };
 
@@ -149,6 +183,10 @@ struct ReceiverCounters {
   uint64_t secure_peer = 0;          // a sealed datagram reached an insecure half
   uint64_t malformed = 0;            // an authentic datagram whose frame is not valid
   uint64_t reassembly_dropped = 0;   // an incomplete message dropped (timeout, limits, too large)
+  uint64_t too_large = 0;            // an authentic message over max_message_bytes (whole or announced)
+  uint64_t hellos = 0;               // session announcements (ground half) or requests (air half)
+  uint64_t commands_verified = 0;    // operator's commands whose signature verified (air half)
+  std::array<uint64_t, seal::kCommandRefusalCount> commands_refused{};  // by seal::CommandRefusal
   seal::OpenerCounters opener;       // opened + refused per seal::Refusal (secure only)
 };
 
@@ -167,6 +205,14 @@ class DoorReceiver {
   std::optional<Delivered> receive(std::span<const uint8_t> datagram, double now_s);
   // Drops incomplete messages older than the timeout.
   void expire(double now_s);
+  // The air half (secure): the operator's channels of the policy must carry a signature this
+  // verifier accepts. Without one, a secure receiver refuses every operator's command (unsigned).
+  void require_operator(seal::CommandVerifier verifier) { verifier_.emplace(std::move(verifier)); }
+  // The ground half: the air half's session from its latest authentic hello.
+  const std::optional<seal::Session>& peer_session() const { return peer_session_; }
+  // The air half: whether the ground half asked for the session (a request, or a command signed
+  // for another session) since the last call.
+  bool take_hello_request() { return std::exchange(hello_wanted_, false); }
 
   bool secure() const { return opener_.has_value(); }
   const ReceiverCounters& counters() const;
@@ -188,12 +234,17 @@ class DoorReceiver {
   std::optional<Delivered> on_frame(uint32_t sender, std::string_view channel, std::span<const uint8_t> frame,
                                     double now_s);
   std::optional<Delivered> admit(std::string channel, std::vector<uint8_t> payload, double now_s);
+  bool on_hello(const std::string& channel, std::span<const uint8_t> frame);
   void drop(std::map<uint64_t, Pending>::iterator it);
   bool refuse(uint64_t& counter, std::string why);
 
   std::optional<seal::Opener> opener_;
   seal::Direction direction_;
   ChannelMatcher allowed_;
+  ChannelMatcher operator_channels_;  // ground -> air only
+  std::optional<seal::CommandVerifier> verifier_;
+  std::optional<seal::Session> peer_session_;
+  bool hello_wanted_ = false;
   RateLimiter rates_;
   ReassemblyLimits limits_;
   std::map<uint64_t, Pending> pending_;  // key: sender << 32 | message id

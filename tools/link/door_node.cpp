@@ -104,7 +104,7 @@ seal::OpenerConfig opener_config(const LinkConfig& c) {
 }  // namespace
 
 DoorHalf::DoorHalf(bus::Bus& bus, UdpSocket& socket, const LinkConfig& config, HalfOptions options,
-                   const seal::SecretKey* key)
+                   const seal::SecretKey* key, CommandKeys commands)
     : Node(bus, options.half == Half::kAir ? "link-air" : "link-ground", config.stats_period_s),
       socket_(socket),
       config_(config),
@@ -128,8 +128,45 @@ DoorHalf::DoorHalf(bus::Bus& bus, UdpSocket& socket, const LinkConfig& config, H
       if (!seal::valid_channel(info.channel)) return;
       relay_.take(info.channel, data, size, info.recv_utime, mono_us());
     }, 10000);
+  if (key_ && options_.half == Half::kAir) {
+    session_ = seal::new_session();
+    if (!commands.operators.empty()) {
+      roles_ = "operators";
+      for (const auto& op : commands.operators) roles_ += " " + op.fingerprint();
+      receiver_.require_operator(seal::CommandVerifier(std::move(commands.operators), session_));
+    } else if (!config_.operator_channels.empty()) {
+      throw std::invalid_argument(
+          "the air half accepts the operator's commands (ground_to_air.operator_channels: " +
+          config_.operator_channels +
+          ") only with the operator's public key: give --operator-pub FILE.pub (aerie-keys operator --out FILE), or set "
+          "ground_to_air.operator_channels: \"\" to accept no command");
+    } else {
+      roles_ = "no operator commands";
+    }
+  } else if (key_) {
+    roles_ = commands.operator_key ? "operator key " + commands.operator_key->public_key().fingerprint()
+                                   : std::string("no operator key: telemetry only, commands refused");
+    std::optional<seal::CommandSigner> signer;
+    if (commands.operator_key) signer.emplace(std::move(*commands.operator_key));
+    sender_.sign_commands(config_.operator_channels, std::move(signer));
+  }
   next_stats_us_ = mono_us() + static_cast<int64_t>(config_.stats_period_s * 1e6);
+  send_hello();
   refresh_status();
+}
+
+void DoorHalf::send_hello() {
+  if (!key_) return;
+  // At most 10 a second, whatever asks: a flood of requests gets no flood of answers.
+  const int64_t now = mono_us();
+  if (last_hello_us_ != 0 && now - last_hello_us_ < 100'000) return;
+  last_hello_us_ = now;
+  datagrams_.resize(1);
+  const bool made = options_.half == Half::kAir ? sender_.hello(session_, now_s(), datagrams_[0])
+                                                : sender_.hello_request(now_s(), datagrams_[0]);
+  if (made && ::sendto(socket_.fd(), datagrams_[0].data(), datagrams_[0].size(), 0,
+                       reinterpret_cast<const sockaddr*>(&peer_), sizeof(peer_)) < 0)
+    ++send_errors_;
 }
 
 double DoorHalf::now_s() const { return static_cast<double>(mono_us()) * 1e-6; }
@@ -142,7 +179,9 @@ std::string DoorHalf::status_line() const {
   std::string s = "SECURE key " + fingerprint_ + " epoch " + std::to_string(sender_.epoch());
   const int64_t pe = receiver_.peer_epoch();
   s += " peer epoch " + (pe < 0 ? std::string("-") : std::to_string(pe));
-  s += std::string("; ") + half_name(options_.half) + " half, sends " + dir;
+  s += std::string("; ") + half_name(options_.half) + " half, sends " + dir + "; " + roles_;
+  if (options_.half == Half::kGround && sender_.has_session()) s += " (air session known)";
+  else if (options_.half == Half::kGround) s += " (waiting for the air half's hello)";
   if (!last_refusal_.empty()) s += "; last refusal: " + last_refusal_;
   return s;
 }
@@ -159,6 +198,10 @@ void DoorHalf::refresh_status() {
   st.set(out + ".fragments", static_cast<int64_t>(s.fragments));
   st.set(out + ".bytes", static_cast<int64_t>(s.bytes));
   st.set(out + ".too_large", static_cast<int64_t>(s.too_large));
+  st.set(out + ".signed_commands", static_cast<int64_t>(s.signed_commands));
+  st.set(out + ".unsigned_commands", static_cast<int64_t>(s.unsigned_commands));
+  st.set(out + ".no_session", static_cast<int64_t>(s.no_session));
+  st.set(out + ".hellos", static_cast<int64_t>(s.hellos));
   st.set(out + ".send_errors", static_cast<int64_t>(send_errors_));
   st.set(out + ".dropped_loss", c.dropped_loss);
   st.set(out + ".dropped_queue", c.dropped_queue);
@@ -173,6 +216,12 @@ void DoorHalf::refresh_status() {
   st.set(in + ".malformed", static_cast<int64_t>(r.malformed));
   st.set(in + ".reassembly_dropped", static_cast<int64_t>(r.reassembly_dropped));
   st.set(in + ".oversize", static_cast<int64_t>(oversize_in_));
+  st.set(in + ".too_large", static_cast<int64_t>(r.too_large));
+  st.set(in + ".hellos", static_cast<int64_t>(r.hellos));
+  st.set(in + ".commands_verified", static_cast<int64_t>(r.commands_verified));
+  for (size_t i = 1; i < seal::kCommandRefusalCount; ++i)
+    st.set(in + ".commands_refused." + counter_name(seal::to_string(static_cast<seal::CommandRefusal>(i))),
+           static_cast<int64_t>(r.commands_refused[i]));
   st.set(in + ".opened", static_cast<int64_t>(r.opener.opened));
   for (size_t i = 1; i < seal::kRefusalCount; ++i)
     st.set(in + ".refused." + counter_name(seal::to_string(static_cast<seal::Refusal>(i))),
@@ -211,6 +260,9 @@ int DoorHalf::receive_datagrams() {
 
 void DoorHalf::send_due(int64_t now_us) {
   const double t = static_cast<double>(now_us) * 1e-6;
+  if (options_.half == Half::kAir && receiver_.take_hello_request()) send_hello();
+  if (const auto& session = receiver_.peer_session()) sender_.set_session(*session);
+  else if (options_.half == Half::kGround) send_hello();  // ask for it
   for (auto& p : relay_.due(now_us)) {
     if (!sender_.send(p.channel, p.data, t, datagrams_)) continue;  // too large: counted
     for (const auto& d : datagrams_) {
@@ -264,6 +316,7 @@ void DoorHalf::tick(int64_t) {
   }
   if (now >= next_stats_us_) {
     publish_stats(now);
+    if (options_.half == Half::kAir) send_hello();  // once a period, unasked
     const int64_t period = static_cast<int64_t>(config_.stats_period_s * 1e6);
     next_stats_us_ += period;
     if (next_stats_us_ < now) next_stats_us_ = now + period;

@@ -47,6 +47,12 @@ class UdpSocket {
   int fd_ = -1;
 };
 
+// The operator's keys beside the mission key (common/seal/operator.hpp, docs/security.md "Roles").
+struct CommandKeys {
+  std::optional<seal::OperatorKey> operator_key;   // the ground half: signs the operator's commands
+  std::vector<seal::OperatorPublicKey> operators;  // the air half: whose commands it accepts
+};
+
 struct HalfOptions {
   Half half = Half::kAir;
   std::string peer;       // ADDR:PORT of the other half
@@ -56,9 +62,12 @@ struct HalfOptions {
 
 class DoorHalf final : public bus::Node {
  public:
-  // key null = insecure (the caller has checked that --insecure was said).
+  // key null = insecure (the caller has checked that --insecure was said). A secure air half
+  // needs the operators' public keys when the config names operator's channels (throws
+  // std::invalid_argument saying so); a secure ground half without an operator key sends no
+  // command (telemetry only: the commands are refused and counted).
   DoorHalf(bus::Bus& bus, UdpSocket& socket, const LinkConfig& config, HalfOptions options,
-           const seal::SecretKey* key);
+           const seal::SecretKey* key, CommandKeys commands = {});
 
   // Sends what the impairments release, expires reassembly, refreshes the status. The half's
   // clock is monotonic (the impairments' and the sealer's): `now_us` (wall) is not used.
@@ -81,6 +90,7 @@ class DoorHalf final : public bus::Node {
  private:
   double now_s() const;
   void send_due(int64_t now_us);
+  void send_hello();
   void publish_stats(int64_t now_us);
 
   UdpSocket& socket_;
@@ -88,6 +98,9 @@ class DoorHalf final : public bus::Node {
   HalfOptions options_;
   const seal::SecretKey* key_;
   std::string fingerprint_;
+  std::string roles_;  // the operator's part of the status line
+  seal::Session session_{};  // the air half's, announced in its hellos
+  int64_t last_hello_us_ = 0;  // the last hello (air) or request for one (ground)
   sockaddr_in peer_{};
   Relay relay_;
   DoorSender sender_;

@@ -22,8 +22,8 @@ LinkConfig::LinkConfig() {
 }
 
 DoorPolicy LinkConfig::policy(seal::Direction d) const {
-  return d == seal::Direction::AirToGround ? DoorPolicy{air_to_ground.channels, air_to_ground_rates}
-                                           : DoorPolicy{ground_to_air.channels, ground_to_air_rates};
+  return d == seal::Direction::AirToGround ? DoorPolicy{air_to_ground.channels, air_to_ground_rates, ""}
+                                           : DoorPolicy{ground_to_air.channels, ground_to_air_rates, operator_channels};
 }
 
 namespace {
@@ -116,6 +116,7 @@ const std::vector<std::string>& known_keys() {
                                "loss.loss_bad", "bandwidth_kbps", "queue_bytes", "queue_policy", "jpeg.channels",
                                "jpeg.quality", "seed", "rate.*"})
         k.push_back(d + "." + leaf);
+    k.push_back("ground_to_air.operator_channels");
     return k;
   }();
   return keys;
@@ -158,6 +159,13 @@ LinkConfig load_link_config(const util::Config& cfg) {
   read_direction(cfg, "ground_to_air", c.ground_to_air);
   c.air_to_ground_rates = read_rates(cfg, "air_to_ground", c.air_to_ground_rates);
   c.ground_to_air_rates = read_rates(cfg, "ground_to_air", c.ground_to_air_rates);
+  c.operator_channels = cfg.get<std::string>("ground_to_air.operator_channels", c.operator_channels);
+  try {
+    ChannelMatcher m(c.operator_channels);
+  } catch (const std::regex_error& e) {
+    throw std::runtime_error(cfg.origin() + ": ground_to_air.operator_channels '" + c.operator_channels +
+                             "' is not a regex: " + e.what());
+  }
 
   RekeyKeys rk{c.rekey.seconds, c.rekey_overlap_s, c.rekey.messages};
   util::SectionReader<RekeyKeys>(cfg.section("rekey"), rk)("seconds", &RekeyKeys::seconds)(

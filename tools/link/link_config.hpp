@@ -25,6 +25,8 @@ struct LinkConfig {
   // sealed datagrams (`rekey`) and the bounds of fragment reassembly (`door`).
   std::vector<RateRule> air_to_ground_rates;
   std::vector<RateRule> ground_to_air_rates;
+  // ground_to_air.operator_channels: the commands that must carry the operator's signature.
+  std::string operator_channels = kDefaultOperatorChannels;
   seal::RekeyPolicy rekey;
   double rekey_overlap_s = 5.0;
   ReassemblyLimits reassembly;

@@ -83,7 +83,8 @@ int main(int argc, char** argv) {
                  "run under SCHED_FIFO at this priority (1..99; needs root or CAP_SYS_NICE) so that a busy\n"
                  "host does not add scheduling delay; 0 = normal scheduling")
       ->check(CLI::Range(0, 99));
-  std::string half, listen, peer, key_path, lcm_url, lcm_netns;
+  std::string half, listen, peer, key_path, lcm_url, lcm_netns, operator_key_path;
+  std::vector<std::string> operator_pubs;
   bool insecure = false;
   uint32_t first_epoch = 0;
   app.add_option("--half", half, "run one half of the door: air or ground (docs/link.md \"The two halves\")")
@@ -91,6 +92,12 @@ int main(int argc, char** argv) {
   app.add_option("--listen", listen, "half: ADDR:PORT of this half's UDP socket (the radio side)");
   app.add_option("--peer", peer, "half: ADDR:PORT of the other half");
   app.add_option("--key", key_path, "half: the mission key file (mode 0600; aerie-keys generate --out FILE)");
+  app.add_option("--operator-key", operator_key_path,
+                 "ground half: the operator's key (mode 0600; aerie-keys operator --out FILE): signs the operator's\n"
+                 "commands (ground_to_air.operator_channels); without it this station only watches");
+  app.add_option("--operator-pub", operator_pubs,
+                 "air half: an operator's public key (FILE.pub of aerie-keys operator; repeat for several\n"
+                 "ground stations): only commands signed by one of them are obeyed");
   app.add_flag("--insecure", insecure,
                "half: run WITHOUT a key -- datagrams in the clear, unauthenticated; the status says INSECURE");
   app.add_option("--lcm-url", lcm_url, "half: this host's LCM URL (default: air_url or ground_url of the config)");
@@ -156,7 +163,16 @@ int main(int argc, char** argv) {
       opt.half = h;
       opt.peer = peer;
       opt.first_epoch = first_epoch;
-      link::DoorHalf door(bus, socket, cfg, opt, key ? &*key : nullptr);
+      link::CommandKeys commands;
+      if (h == link::Half::kAir && !operator_key_path.empty())
+        throw std::invalid_argument("--operator-key is the ground half's (the air half takes --operator-pub FILE.pub)");
+      if (h == link::Half::kGround && !operator_pubs.empty())
+        throw std::invalid_argument("--operator-pub is the air half's (the ground half takes --operator-key FILE)");
+      if (!key && (!operator_key_path.empty() || !operator_pubs.empty()))
+        throw std::invalid_argument("--operator-key/--operator-pub need --key: an --insecure door checks no signature");
+      if (!operator_key_path.empty()) commands.operator_key.emplace(seal::OperatorKey::load(operator_key_path));
+      for (const auto& p : operator_pubs) commands.operators.push_back(seal::OperatorPublicKey::load(p));
+      link::DoorHalf door(bus, socket, cfg, opt, key ? &*key : nullptr, std::move(commands));
       const auto& o = h == link::Half::kAir ? cfg.air_to_ground : cfg.ground_to_air;
       const auto& i = h == link::Half::kAir ? cfg.ground_to_air : cfg.air_to_ground;
       spdlog::info("{} half: LCM {} <-> UDP {} (port {}) -> peer {}", half, url, listen, socket.port(), peer);
@@ -166,8 +182,11 @@ int main(int argc, char** argv) {
       door.run();
       return 0;
     }
-    if (!listen.empty() || !peer.empty() || !key_path.empty() || insecure || !lcm_netns.empty())
-      throw std::invalid_argument("--listen, --peer, --key, --insecure and --lcm-netns are options of --half air|ground");
+    if (!listen.empty() || !peer.empty() || !key_path.empty() || insecure || !lcm_netns.empty() ||
+        !operator_key_path.empty() || !operator_pubs.empty())
+      throw std::invalid_argument(
+          "--listen, --peer, --key, --operator-key, --operator-pub, --insecure and --lcm-netns are options of --half "
+          "air|ground");
 
     if (rt_priority > 0) {
       // Before the LCM threads start: they inherit the policy.

@@ -36,10 +36,24 @@ SimLink::SimLink(bus::Bus& air, bus::Bus& ground, const DirectionConfig& down, c
     const seal::SecretKey* k = door->key.get();
     door_down_ = std::make_unique<DoorEnds>(DoorEnds{
         DoorSender(k, seal::Direction::AirToGround, 1, 0, 0.0, door->rekey, door->limits),
-        DoorReceiver(k, seal::Direction::AirToGround, DoorPolicy{down.channels, door->down_rates}, o, door->limits)});
+        DoorReceiver(k, seal::Direction::AirToGround, DoorPolicy{down.channels, door->down_rates, ""}, o, door->limits)});
     door_up_ = std::make_unique<DoorEnds>(DoorEnds{
         DoorSender(k, seal::Direction::GroundToAir, 2, 0, 0.0, door->rekey, door->limits),
-        DoorReceiver(k, seal::Direction::GroundToAir, DoorPolicy{up.channels, door->up_rates}, o, door->limits)});
+        DoorReceiver(k, seal::Direction::GroundToAir, DoorPolicy{up.channels, door->up_rates, door->operator_channels},
+                     o, door->limits)});
+    if (k && !door->operator_channels.empty()) {
+      // The air half's session, announced down through the door as aerie-link --half air does.
+      const seal::Session session = seal::new_session();
+      if (door->operator_key)
+        door_up_->receiver.require_operator(seal::CommandVerifier({door->operator_key->public_key()}, session));
+      std::optional<seal::CommandSigner> signer;
+      if (door->operator_key) signer.emplace(door->operator_key->clone());
+      door_up_->sender.sign_commands(door->operator_channels, std::move(signer));
+      std::vector<uint8_t> hello;
+      door_down_->sender.hello(session, 0.0, hello);
+      door_down_->receiver.receive(hello, 0.0);
+      if (door_down_->receiver.peer_session()) door_up_->sender.set_session(*door_down_->receiver.peer_session());
+    }
   }
   // Deep queues: in lock-step nothing may be dropped before the link model decides.
   if (!down.channels.empty())

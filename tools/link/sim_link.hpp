@@ -41,6 +41,12 @@ struct SimDoor {
   double overlap_s = 5.0;
   ReassemblyLimits limits;
   std::vector<RateRule> down_rates, up_rates;
+  // The operator's role (common/seal/operator.hpp): ground -> air messages on operator_channels
+  // are signed with operator_key by the ground half, for the session the air half announced in
+  // its hello, and checked by the air half. "" = no operator's channels; with channels but no
+  // key the air half refuses those commands, as aerie-link's ground half without --operator-key.
+  std::string operator_channels;
+  std::shared_ptr<const seal::OperatorKey> operator_key;
   // Test hooks (tests/tools/door/test_door_attacks.cpp): `tap` sees each datagram a sending
   // half sealed (down: air->ground), before the far half opens it; `on_deliver` is called at
   // the start of each SimLink::deliver(), where a test may SimLink::inject() what a third

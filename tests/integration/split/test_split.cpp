@@ -22,6 +22,7 @@
 
 #include "common/bus/bus.hpp"
 #include "common/seal/keys.hpp"
+#include "common/seal/operator.hpp"
 #include "common/util/time.hpp"
 #include "procman/testbed.hpp"
 #include "tests/support/test_support.hpp"
@@ -214,12 +215,19 @@ TEST_F(Split, ThroughTheSealedHalves) {
   testbed::run({"ip", "-n", ground_->name(), "route", "add", "239.255.76.68/32", "dev", "lo"});
   const std::string key = (dir_ / "mission.key").string();
   aerie::seal::save_key(key, aerie::seal::SecretKey::generate());
+  // The operator's key: the ground half signs the commands, the air half checks them.
+  const std::string op_key = (dir_ / "operator.key").string();
+  const aerie::seal::OperatorKey op = aerie::seal::OperatorKey::generate();
+  op.save(op_key);
+  op.public_key().save(op_key + ".pub");
   const std::string cfg = shipped_link_with_procman(dir_);
   const std::vector<std::string> fixed = {"--delay-ms", "15", "--jitter-ms", "0", "--loss", "0", "--bandwidth-kbps", "0"};
   std::vector<std::string> air_half = {bin("aerie-link"), "--half", "air", "--config", cfg, "--key", key, "--listen",
-                                       "10.213.0.1:17200", "--peer", "10.213.0.2:17200", "--lcm-url", air_url};
+                                       "10.213.0.1:17200", "--peer", "10.213.0.2:17200", "--lcm-url", air_url,
+                                       "--operator-pub", op_key + ".pub"};
   std::vector<std::string> ground_half = {bin("aerie-link"), "--half", "ground", "--config", cfg, "--key", key, "--listen",
-                                          "10.213.0.2:17200", "--peer", "10.213.0.1:17200", "--lcm-url", ground_url};
+                                          "10.213.0.2:17200", "--peer", "10.213.0.1:17200", "--lcm-url", ground_url,
+                                          "--operator-key", op_key};
   air_half.insert(air_half.end(), fixed.begin(), fixed.end());
   ground_half.insert(ground_half.end(), fixed.begin(), fixed.end());
   auto& air_door = start(*air_, air_half, "link-air.log");

@@ -10,6 +10,7 @@
 #include <numeric>
 #include <set>
 
+#include "common/seal/operator.hpp"
 #include "common/seal/seal.hpp"
 #include "tests/support/test_support.hpp"
 #include "tools/link/door.hpp"
@@ -33,7 +34,7 @@ std::vector<uint8_t> numbered(uint32_t i) {
   return v;
 }
 
-DoorPolicy anything() { return DoorPolicy{".*", {}}; }
+DoorPolicy anything() { return DoorPolicy{".*", {}, ""}; }
 
 struct Pair {
   seal::SecretKey key = seal::SecretKey::generate();
@@ -43,6 +44,14 @@ struct Pair {
   explicit Pair(DoorPolicy policy = anything(), seal::RekeyPolicy rekey = {}, ReassemblyLimits limits = {},
                 Direction d = Direction::GroundToAir)
       : tx(&key, d, 7, 0, 0.0, rekey, limits), rx(&key, d, std::move(policy), {}, limits) {}
+  // The operator's role on this (ground -> air) pair: the receiver checks `operator_key`'s
+  // signature for `session`, announced as the air half does; the sender signs.
+  seal::Session session = seal::new_session();
+  void with_operator(const seal::OperatorKey& operator_key, const std::string& channels = kDefaultOperatorChannels) {
+    rx.require_operator(seal::CommandVerifier({operator_key.public_key()}, session));
+    tx.sign_commands(channels, seal::CommandSigner(operator_key.clone()));
+    tx.set_session(session);
+  }
   // Sends one message and feeds every datagram to the receiver; what it delivered.
   std::vector<Delivered> cross(const std::string& channel, const std::vector<uint8_t>& payload, double t) {
     std::vector<Delivered> got;
@@ -210,7 +219,7 @@ TEST(DoorMustNotConnect, ADatagramOfAnEpochTwoBackIsRefusedAsExpired) {
 // --- policy ----------------------------------------------------------------------------------
 
 TEST(DoorPolicy, AChannelNotAllowedIsDroppedAndCountedBeforeReassembly) {
-  Pair p(DoorPolicy{"PILOT_CMD|TRACK_CMD", {}});
+  Pair p(DoorPolicy{"PILOT_CMD|TRACK_CMD", {}, ""});
   EXPECT_EQ(p.cross("PILOT_CMD", bytes(10, 1), 0).size(), 1u);
   EXPECT_TRUE(p.cross("CTRL_CMD", bytes(10, 1), 0).empty());
   EXPECT_TRUE(p.cross("PMD_ORDERS2", bytes(200000, 1), 0).empty());  // fragmented: never buffered
@@ -229,8 +238,12 @@ TEST(DoorPolicy, TheShippedConfigLetsNoProcmanChannelCrossAndCarriesTheOperators
     EXPECT_EQ(p.rx.counters().not_allowed, 5u);
   }
   Pair up(cfg.policy(Direction::GroundToAir));
+  up.with_operator(seal::OperatorKey::generate(), cfg.operator_channels);
   for (const char* c : {"PILOT_CMD", "TRACK_CMD", "FLC_PARAMS", "MAP_CMD", "MAP_QUERY", "MAP_RESPONSE"})
     EXPECT_EQ(up.cross(c, bytes(30, 1), 0).size(), 1u) << c << " does not cross ground->air";
+  // The operator's commands went up signed; the map's data did not need it.
+  EXPECT_EQ(up.tx.counters().signed_commands, 4u);
+  EXPECT_EQ(up.rx.counters().commands_verified, 4u);
   Pair down(cfg.policy(Direction::AirToGround), {}, {}, Direction::AirToGround);
   EXPECT_TRUE(down.cross("PILOT_CMD", bytes(30, 1), 0).empty());  // commands go up only
   EXPECT_EQ(down.cross("VO_POSE", bytes(30, 1), 0).size(), 1u);
@@ -238,7 +251,7 @@ TEST(DoorPolicy, TheShippedConfigLetsNoProcmanChannelCrossAndCarriesTheOperators
 
 TEST(DoorPolicy, AFloodIsRateLimitedWithExactCounts) {
   // 20 messages/s, bucket 40: a burst of 100 at once lets 40 through; 1 s later 20 more.
-  Pair p(DoorPolicy{".*", {RateRule{"PILOT_CMD", 20, 40, 0, 0}}});
+  Pair p(DoorPolicy{".*", {RateRule{"PILOT_CMD", 20, 40, 0, 0}}, ""});
   int through = 0;
   for (int i = 0; i < 100; ++i) through += static_cast<int>(p.cross("PILOT_CMD", bytes(16, 1), 0.0).size());
   EXPECT_EQ(through, 40);
@@ -252,7 +265,7 @@ TEST(DoorPolicy, AFloodIsRateLimitedWithExactCounts) {
 }
 
 TEST(DoorPolicy, BytesPerSecondLimitsLargeMessages) {
-  Pair p(DoorPolicy{".*", {RateRule{"MAP_CMD", 0, 0, 10000, 10000}}});
+  Pair p(DoorPolicy{".*", {RateRule{"MAP_CMD", 0, 0, 10000, 10000}}, ""});
   int through = 0;
   for (int i = 0; i < 10; ++i) through += static_cast<int>(p.cross("MAP_CMD", bytes(3000, 1), 0.0).size());
   EXPECT_EQ(through, 3);  // 3 x 3000 <= 10000
@@ -383,4 +396,133 @@ TEST(DoorConfig, UnknownKeysAndBadValuesAreRefusedNamingFileKeyAndLine) {
   EXPECT_NE(e.find("bad.yaml: door: max_datagram_bytes"), std::string::npos) << e;
   e = refusal("stats: {period: 1}\n");
   EXPECT_NE(e.find("stats.period"), std::string::npos) << e;
+}
+
+// --- the operator's role (common/seal/operator.hpp) ----------------------------------------------
+
+namespace {
+size_t refused(const DoorReceiver& rx, seal::CommandRefusal r) {
+  return rx.counters().commands_refused[static_cast<size_t>(r)];
+}
+}  // namespace
+
+TEST(DoorOperator, TheGroundHalfLearnsTheSessionFromTheAirHalfsHelloAndItsCommandsAreObeyed) {
+  const seal::SecretKey key = seal::SecretKey::generate();
+  const seal::OperatorKey op = seal::OperatorKey::generate();
+  const seal::Session session = seal::new_session();
+  DoorPolicy up_policy{"PILOT_CMD|VO_POSE", {}, "PILOT_CMD"};
+  DoorSender air_tx(&key, Direction::AirToGround, 1, 0, 0.0);
+  DoorReceiver ground_rx(&key, Direction::AirToGround, anything());
+  DoorSender ground_tx(&key, Direction::GroundToAir, 2, 0, 0.0);
+  DoorReceiver air_rx(&key, Direction::GroundToAir, up_policy);
+  air_rx.require_operator(seal::CommandVerifier({op.public_key()}, session));
+  ground_tx.sign_commands("PILOT_CMD", seal::CommandSigner(op.clone()));
+  std::vector<std::vector<uint8_t>> out;
+
+  // Before the hello the ground half has no session: the command is held back and counted.
+  EXPECT_FALSE(ground_tx.send("PILOT_CMD", bytes(20, 1), 0.0, out));
+  EXPECT_EQ(ground_tx.counters().no_session, 1u);
+  std::vector<uint8_t> hello;
+  ASSERT_TRUE(air_tx.hello(session, 0.0, hello));
+  EXPECT_FALSE(ground_rx.receive(hello, 0.0));  // not a message: nothing is published
+  ASSERT_TRUE(ground_rx.peer_session());
+  EXPECT_EQ(*ground_rx.peer_session(), session);
+  EXPECT_EQ(ground_rx.counters().hellos, 1u);
+  ground_tx.set_session(*ground_rx.peer_session());
+
+  ASSERT_TRUE(ground_tx.send("PILOT_CMD", bytes(20, 1), 0.1, out));
+  auto m = air_rx.receive(out[0], 0.1);
+  ASSERT_TRUE(m) << air_rx.why();
+  EXPECT_EQ(m->payload, bytes(20, 1));  // the envelope is gone
+  // Not an operator's channel: crosses with the mission key alone.
+  ASSERT_TRUE(ground_tx.send("VO_POSE", bytes(20, 2), 0.2, out));
+  EXPECT_TRUE(air_rx.receive(out[0], 0.2));
+  EXPECT_EQ(air_rx.counters().commands_verified, 1u);
+  // A hello is the air half's only: one sent up is refused as malformed.
+  ASSERT_TRUE(ground_tx.hello(session, 0.3, hello));
+  EXPECT_FALSE(air_rx.receive(hello, 0.3));
+  EXPECT_EQ(air_rx.counters().malformed, 1u);
+  // An insecure sender makes no hello.
+  DoorSender clear(nullptr, Direction::AirToGround, 1, 0, 0.0);
+  EXPECT_FALSE(clear.hello(session, 0.0, hello));
+}
+
+TEST(DoorOperator, AMissionKeyHolderWithoutTheOperatorsKeyCannotCommand) {
+  // The intruder holds the mission key (a stolen telemetry station, the vehicle itself): its
+  // datagrams open, but its commands are refused by reason and nothing is published.
+  Pair p(DoorPolicy{".*", {}, kDefaultOperatorChannels});
+  const seal::OperatorKey op = seal::OperatorKey::generate();
+  p.with_operator(op);
+  DoorSender intruder(&p.key, Direction::GroundToAir, 99, 0, 0.0);
+  std::vector<std::vector<uint8_t>> out;
+  const auto cmd = bytes(24, 5);
+
+  // 1. A bare command.
+  ASSERT_TRUE(intruder.send("PILOT_CMD", cmd, 0.0, out));
+  EXPECT_FALSE(p.rx.receive(out[0], 0.0));
+  EXPECT_EQ(refused(p.rx, seal::CommandRefusal::Unsigned), 1u);
+  // 2. Signed with a key of its own.
+  intruder.sign_commands("PILOT_CMD", seal::CommandSigner(seal::OperatorKey::generate()));
+  intruder.set_session(p.session);
+  ASSERT_TRUE(intruder.send("PILOT_CMD", cmd, 0.1, out));
+  EXPECT_FALSE(p.rx.receive(out[0], 0.1));
+  EXPECT_EQ(refused(p.rx, seal::CommandRefusal::BadSignature), 1u);
+  // 3. The operator's genuine command, captured (the intruder opens it with the mission key)
+  //    and re-sealed as its own datagram: the seal is fresh, the command is a replay.
+  ASSERT_TRUE(p.tx.send("PILOT_CMD", cmd, 0.2, out));
+  seal::Opener tap(p.key, {.direction = Direction::GroundToAir});
+  const seal::Opened captured = tap.open(out[0], 0.2);
+  ASSERT_TRUE(captured);
+  ASSERT_TRUE(p.rx.receive(out[0], 0.2));  // the genuine one is obeyed, once
+  seal::Sealer resealer(p.key, Direction::GroundToAir, 98, 0, 0.0);
+  EXPECT_FALSE(p.rx.receive(resealer.seal("PILOT_CMD", captured.payload, 0.3), 0.3));
+  EXPECT_EQ(refused(p.rx, seal::CommandRefusal::Replayed), 1u);
+  // 4. ... and replayed to the air half after it restarted (a new session).
+  DoorPolicy commands{".*", {}, kDefaultOperatorChannels};
+  DoorReceiver restarted_air(&p.key, Direction::GroundToAir, commands);
+  restarted_air.require_operator(seal::CommandVerifier({op.public_key()}, seal::new_session()));
+  EXPECT_FALSE(restarted_air.receive(resealer.seal("PILOT_CMD", captured.payload, 0.4), 0.4));
+  EXPECT_EQ(refused(restarted_air, seal::CommandRefusal::OtherSession), 1u);
+  // 5. Moved to another operator's channel.
+  EXPECT_FALSE(p.rx.receive(resealer.seal("TRACK_CMD", captured.payload, 0.5), 0.5));
+  EXPECT_EQ(refused(p.rx, seal::CommandRefusal::BadSignature), 2u);
+  EXPECT_EQ(p.rx.counters().delivered, 1u);  // the operator's one command, nothing else
+  EXPECT_EQ(p.rx.counters().commands_verified, 1u);
+}
+
+TEST(DoorOperator, ASecureHalfWithoutOperatorKeysNeitherSendsNorObeysCommands) {
+  // The ground half without --operator-key (a station that only watches) refuses to send them;
+  // an air half that has no operator's public key refuses them (fail closed).
+  const seal::SecretKey key = seal::SecretKey::generate();
+  DoorSender watcher(&key, Direction::GroundToAir, 3, 0, 0.0);
+  watcher.sign_commands(kDefaultOperatorChannels, std::nullopt);
+  std::vector<std::vector<uint8_t>> out;
+  EXPECT_FALSE(watcher.send("PILOT_CMD", bytes(10, 1), 0.0, out));
+  EXPECT_EQ(watcher.counters().unsigned_commands, 1u);
+  EXPECT_TRUE(watcher.send("MAP_RESPONSE", bytes(10, 1), 0.0, out));  // data, not a command
+
+  DoorReceiver air(&key, Direction::GroundToAir, DoorPolicy{".*", {}, kDefaultOperatorChannels});
+  DoorSender plain(&key, Direction::GroundToAir, 4, 0, 0.0);
+  ASSERT_TRUE(plain.send("TRACK_CMD", bytes(10, 1), 0.0, out));
+  EXPECT_FALSE(air.receive(out[0], 0.0));
+  EXPECT_EQ(refused(air, seal::CommandRefusal::Unsigned), 1u);
+  EXPECT_NE(air.why().find("no operator public key"), std::string::npos) << air.why();
+}
+
+TEST(DoorReassembly, AWholeMessageOverTheReceiversLimitIsRefusedAndCounted) {
+  // A sender with a looser limit than the receiver's: the receiver's own bound holds.
+  ReassemblyLimits tight;
+  tight.max_message_bytes = 1000;
+  tight.max_pending_bytes = 1000;
+  const seal::SecretKey key = seal::SecretKey::generate();
+  DoorSender tx(&key, Direction::AirToGround, 1, 0, 0.0);
+  DoorReceiver rx(&key, Direction::AirToGround, anything(), {}, tight);
+  std::vector<std::vector<uint8_t>> out;
+  ASSERT_TRUE(tx.send("VO_POSE", bytes(1001, 1), 0.0, out));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_FALSE(rx.receive(out[0], 0.0));
+  ASSERT_TRUE(tx.send("VO_POSE", bytes(1000, 1), 0.0, out));
+  EXPECT_TRUE(rx.receive(out[0], 0.0));
+  EXPECT_EQ(rx.counters().too_large, 1u);
+  EXPECT_EQ(rx.counters().delivered, 1u);
 }

@@ -50,6 +50,12 @@ struct Message {
 
 // As test_door_landing's split, with the operator's commands also allowed up (as the secure
 // config/link.yaml carries them): the policy would let them cross, the seal is what refuses.
+// The operator's key of both flights (a run's signatures differ, what is published does not).
+std::shared_ptr<const seal::OperatorKey> operator_key() {
+  static const auto key = std::make_shared<const seal::OperatorKey>(seal::OperatorKey::generate());
+  return key;
+}
+
 landing::RunConfig landing_split(std::shared_ptr<const seal::SecretKey> key) {
   landing::RunConfig rc;
   rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
@@ -70,16 +76,23 @@ landing::RunConfig landing_split(std::shared_ptr<const seal::SecretKey> key) {
   split.up.seed = 4;
   link::SimDoor door;
   door.key = std::move(key);  // default rekeying: one epoch for the flight, so each refusal's reason is exact
+  door.operator_channels = link::kDefaultOperatorChannels;  // the operator signs, as aerie-link's halves
+  door.operator_key = operator_key();
   split.door = door;
   rc.split = split;
   return rc;
 }
 
-// The attacker: no mission key (its own random one, or none), and what it sees of the radio.
+// The attacker: no mission key (its own random one, or none), and what it sees of the radio --
+// and an insider who holds the mission key (a stolen ground station that only watched) but not
+// the operator's key.
 class Attacker {
  public:
+  explicit Attacker(std::shared_ptr<const seal::SecretKey> mission)
+      : insider_(mission.get(), seal::Direction::GroundToAir, 9, 0, 0.0) {}
   // What each injected datagram was refused as, per attack.
   std::map<std::string, std::map<Refusal, int>> refused;
+  std::map<std::string, std::map<seal::CommandRefusal, int>> command_refused;  // the insider's
   std::map<std::string, int> insecure, published, other;
   std::map<std::string, int> sent;  // datagrams injected, per attack
   int injected = 0, frames = 0, seconds = 0;
@@ -106,6 +119,11 @@ class Attacker {
     for (size_t r = 1; r < seal::kRefusalCount; ++r)
       if (last.opener.refused[r] == before.opener.refused[r] + 1) {
         ++refused[attack][static_cast<Refusal>(r)];
+        return;
+      }
+    for (size_t r = 1; r < seal::kCommandRefusalCount; ++r)
+      if (last.commands_refused[r] == before.commands_refused[r] + 1) {
+        ++command_refused[attack][static_cast<seal::CommandRefusal>(r)];
         return;
       }
     ++other[attack];
@@ -187,15 +205,24 @@ class Attacker {
       ASSERT_TRUE(keyless_.send("PILOT_CMD", p, now_s, datagrams_));
       for (const auto& d : datagrams_) inject("pilot_abort_in_the_clear", d);
     }
-    auto pilot = [&](int8_t command, const char* attack) {
+    auto pilot = [&](int8_t command, const char* attack, link::DoorSender* sender = nullptr) {
       aerie::pilot_cmd_t c{};
       c.utime = ut;
       c.seq = frame;
       c.command = command;
       c.source = "operator";
-      forge(attack, "PILOT_CMD", c, now_s);
+      forge(attack, "PILOT_CMD", c, now_s, sender);
     };
     if (frame == 40) pilot(aerie::pilot_cmd_t::ABORT, "pilot_abort");
+    // The insider: sealed with the mission key, so the datagrams open; the commands do not pass.
+    if (frame == 70) pilot(aerie::pilot_cmd_t::LAND, "insider_pilot_land", &insider_);
+    if (frame == 110) {
+      // Signed with a key of its own, for the session it learnt by opening the air half's hello.
+      insider_.sign_commands("PILOT_CMD", seal::CommandSigner(seal::OperatorKey::generate()));
+      insider_.set_session(*link_->door(true)->receiver.peer_session());
+      pilot(aerie::pilot_cmd_t::ABORT, "insider_signed_abort", &insider_);
+      insider_.sign_commands("", std::nullopt);
+    }
     if (frame == 60) pilot(aerie::pilot_cmd_t::LAND, "pilot_land");
     if (frame == 80) {
       aerie::track_cmd_t c{};
@@ -252,6 +279,7 @@ class Attacker {
     }
   }
 
+  link::DoorSender insider_;
   seal::SecretKey wrong_ = seal::SecretKey::generate();
   link::DoorSender forger_{&wrong_, seal::Direction::GroundToAir, 7, 0, 0.0};   // a sender id of its own
   link::DoorSender spoofer_{&wrong_, seal::Direction::GroundToAir, 2, 0, 0.0};  // the ground's sender id
@@ -289,7 +317,7 @@ TEST(DoorAttacks, EveryAttackOfTheProbeIsRefusedAndCountedAndTheVehicleLandsAsWi
   const auto key = std::make_shared<const seal::SecretKey>(seal::SecretKey::generate());
   landing::RunResult plain, attacked;
   const auto a = record(landing_split(key), plain);
-  Attacker attacker;
+  Attacker attacker(key);
   landing::RunConfig rc = landing_split(key);
   attacker.attach(*rc.split->door);
   const auto b = record(rc, attacked);
@@ -323,6 +351,17 @@ TEST(DoorAttacks, EveryAttackOfTheProbeIsRefusedAndCountedAndTheVehicleLandsAsWi
   for (const auto& [attack, want] : expected) {
     EXPECT_EQ(attacker.sent[attack], want.second) << attack;
     EXPECT_EQ(attacker.refused[attack], (std::map<Refusal, int>{{want.first, want.second}}))
+        << attack << " refused as " << seal::to_string(want.first);
+    total += want.second;
+  }
+  // The insider's commands: authentic datagrams, refused for their signature.
+  const std::map<std::string, std::pair<seal::CommandRefusal, int>> insider = {
+      {"insider_pilot_land", {seal::CommandRefusal::Unsigned, 1}},
+      {"insider_signed_abort", {seal::CommandRefusal::BadSignature, 1}},
+  };
+  for (const auto& [attack, want] : insider) {
+    EXPECT_EQ(attacker.sent[attack], want.second) << attack;
+    EXPECT_EQ(attacker.command_refused[attack], (std::map<seal::CommandRefusal, int>{{want.first, want.second}}))
         << attack << " refused as " << seal::to_string(want.first);
     total += want.second;
   }

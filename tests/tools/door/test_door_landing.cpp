@@ -22,6 +22,9 @@ link::SimDoor door_every_10s() {
   d.key = std::make_shared<const seal::SecretKey>(seal::SecretKey::generate());
   d.rekey.seconds = 10;
   d.overlap_s = 5;
+  // The operator's role as aerie-link's halves have it: the commands going up are signed.
+  d.operator_channels = link::kDefaultOperatorChannels;
+  d.operator_key = std::make_shared<const seal::OperatorKey>(seal::OperatorKey::generate());
   return d;
 }
 

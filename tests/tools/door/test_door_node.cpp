@@ -24,6 +24,7 @@
 
 #include "common/bus/bus.hpp"
 #include "common/seal/keys.hpp"
+#include "common/seal/operator.hpp"
 #include "common/util/time.hpp"
 #include "procman/testbed.hpp"
 #include "tests/support/test_support.hpp"
@@ -90,6 +91,7 @@ class DoorNode : public ::testing::Test {
     if (const auto why = testbed::namespaces_unavailable(); !why.empty()) GTEST_SKIP() << why;
     ns_ = std::make_unique<testbed::NetNamespace>(testbed::unique_name("door"));
     dir_ = test::scratch_dir("door");
+    write_operator_key();
     key_ = write_key("mission.key");
     other_key_ = write_key("other.key");
     config_ = write_config("link.yaml", "");
@@ -116,6 +118,14 @@ class DoorNode : public ::testing::Test {
     ground_.reset();
   }
 
+  // The operator's key pair, as aerie-keys operator writes it.
+  void write_operator_key() {
+    operator_key_ = (dir_ / "operator.key").string();
+    operator_pub_ = operator_key_ + ".pub";
+    const seal::OperatorKey k = seal::OperatorKey::generate();
+    k.save(operator_key_);
+    k.public_key().save(operator_pub_);
+  }
   std::string write_key(const std::string& name) {
     const auto path = (dir_ / name).string();
     seal::save_key(path, seal::SecretKey::generate());
@@ -140,6 +150,10 @@ class DoorNode : public ::testing::Test {
                              "--lcm-url", air ? kAir : kGround, "--delay-ms", delay_ms, "--jitter-ms", "0", "--loss", "0",
                              "--bandwidth-kbps", "0", "--log-level", "debug"});
     argv.insert(argv.end(), args.begin(), args.end());
+    // A keyed half gets the operator's role too: the ground half signs, the air half checks.
+    if (operator_role_ && std::find(args.begin(), args.end(), "--key") != args.end() &&
+        std::find(args.begin(), args.end(), "--insecure") == args.end())
+      argv.insert(argv.end(), {air ? "--operator-pub" : "--operator-key", air ? operator_pub_ : operator_key_});
     halves_.push_back(std::make_unique<testbed::Process>(argv, (dir_ / (half + std::to_string(halves_.size()) + ".log")).string()));
     return *halves_.back();
   }
@@ -148,6 +162,8 @@ class DoorNode : public ::testing::Test {
     const auto until = std::chrono::steady_clock::now() + 20s;
     while ((!air_status_ || !ground_status_) && std::chrono::steady_clock::now() < until) spin(50ms);
     ASSERT_TRUE(air_status_ && ground_status_) << logs();
+    // A keyed ground half signs the operator's commands once it knows the air half's session.
+    spin_until([&] { return ground_status_->message.find("waiting for the air half") == std::string::npos; }, 5s);
   }
   void spin(std::chrono::milliseconds d) {
     testbed::EnterNamespace inside(*ns_);
@@ -191,7 +207,8 @@ class DoorNode : public ::testing::Test {
 
   std::unique_ptr<testbed::NetNamespace> ns_;
   std::filesystem::path dir_;
-  std::string key_, other_key_, config_;
+  std::string key_, other_key_, config_, operator_key_, operator_pub_;
+  bool operator_role_ = true;  // start() gives keyed halves the operator's keys
   std::unique_ptr<bus::Bus> air_, ground_;
   std::optional<aerie::process_status_t> air_status_, ground_status_, air_status_on_ground_;
   std::vector<aerie::pilot_cmd_t> pilot_on_air_;
@@ -213,6 +230,15 @@ TEST_F(DoorNode, WithoutAKeyAHalfRefusesToStartAndAKeyOthersCanReadIsRefused) {
   auto& both = start("ground", {"--key", key_, "--insecure"});
   ASSERT_EQ(both.wait(10s).value_or(-1), 1) << both.log();
   EXPECT_NE(both.log().find("exclude each other"), std::string::npos) << both.log();
+  // A keyed air half without the operator's public key would obey no command (or anyone's):
+  // it refuses to start, naming the option; a ground half without an operator key only watches.
+  operator_role_ = false;
+  auto& no_operator = start("air", {"--key", key_});
+  ASSERT_EQ(no_operator.wait(10s).value_or(-1), 1) << no_operator.log();
+  EXPECT_NE(no_operator.log().find("--operator-pub"), std::string::npos) << no_operator.log();
+  auto& wrong_half = start("air", {"--key", key_, "--operator-key", operator_key_});
+  ASSERT_EQ(wrong_half.wait(10s).value_or(-1), 1) << wrong_half.log();
+  EXPECT_NE(wrong_half.log().find("is the ground half's"), std::string::npos) << wrong_half.log();
 }
 
 TEST_F(DoorNode, SecureHalvesCarryTheOperatorsAbortUpAndTelemetryDownAndShowTheSameFingerprint) {
@@ -257,11 +283,14 @@ TEST_F(DoorNode, WrongKeyNothingCrossesAndTheReasonIsCounted) {
   for (int i = 1; i <= 20; ++i) {
     publish_abort(i);
     publish_raw(true, "VO_POSE");
+    publish_raw(false, "MAP_RESPONSE");
     spin(50ms);
   }
   fresh_status();
   EXPECT_TRUE(pilot_on_air_.empty());
   EXPECT_EQ(on_ground_["VO_POSE"], 0);
+  // The ground half never opened the air half's hello: it holds the operator's commands back.
+  EXPECT_EQ(counter(*ground_status_, "ground_to_air.no_session"), 20) << logs();
   EXPECT_GE(counter(*air_status_, "ground_to_air.refused.authentication_failed"), 15) << logs();
   EXPECT_EQ(counter(*air_status_, "ground_to_air.delivered"), 0);
   EXPECT_GE(counter(*ground_status_, "air_to_ground.refused.authentication_failed"), 15);

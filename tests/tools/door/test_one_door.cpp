@@ -22,6 +22,7 @@
 
 #include "common/bus/bus.hpp"
 #include "common/seal/keys.hpp"
+#include "common/seal/operator.hpp"
 #include "common/util/time.hpp"
 #include "procman/testbed.hpp"
 #include "tests/support/test_support.hpp"
@@ -110,6 +111,10 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
   testbed::run({"ip", "-n", ground.name(), "route", "add", "239.255.76.68/32", "dev", "lo"});
   const std::string key = (dir / "mission.key").string();
   seal::save_key(key, seal::SecretKey::generate());
+  const std::string op_key = (dir / "operator.key").string();
+  const seal::OperatorKey op = seal::OperatorKey::generate();
+  op.save(op_key);
+  op.public_key().save(op_key + ".pub");
   const std::string cfg = (test::source_dir() / "config/link.yaml").string();
   const std::string script = (test::source_dir() / "scripts/air-netns.sh").string();
   const std::string bin = (test::binary_dir() / "bin").string();
@@ -136,13 +141,13 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
   std::vector<std::string> air_half = {"bash", script, "door", "--nodes-ns", nodes.name(), "--radio-ns", radio.name(),
                                        "--bin", bin, "--config", cfg, "--", "--key", key,
                                        "--listen", kAirRadio + ":" + door, "--peer", kGroundRadio + ":" + door,
-                                       "--lcm-url", kAirUrl};
+                                       "--lcm-url", kAirUrl, "--operator-pub", op_key + ".pub"};
   air_half.insert(air_half.end(), no_impairments.begin(), no_impairments.end());
   testbed::Process air_door(air_half, (dir / "air-half.log").string());
   auto ground_half = ground.exec_prefix();
   ground_half.insert(ground_half.end(), {bin + "/aerie-link", "--half", "ground", "--config", cfg, "--key", key,
                                          "--listen", kGroundRadio + ":" + door, "--peer", kAirRadio + ":" + door,
-                                         "--lcm-url", kGroundUrl});
+                                         "--lcm-url", kGroundUrl, "--operator-key", op_key});
   ground_half.insert(ground_half.end(), no_impairments.begin(), no_impairments.end());
   testbed::Process ground_door(ground_half, (dir / "ground-half.log").string());
   auto spin = [&](std::chrono::milliseconds d) {
