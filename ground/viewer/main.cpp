@@ -7,12 +7,14 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 #include <thread>
 
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/heap.hpp"
 #include "common/util/time.hpp"
+#include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/viewer.hpp"
 
 namespace {
@@ -64,6 +66,11 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--duration", duration, "exit after this many seconds (headless runs)");
   app.add_option("--disable", disable, "renderers to start disabled (by name, e.g. octomap chart-latency)");
+  std::string key_path;
+  app.add_option("--key", key_path,
+                 "mission key file (mode 0600): the process panel's start/stop orders are tagged as a keyed "
+                 "sheriff's (PMD_ORDERS2_SEALED); without it they are libbot2's plain PMD_ORDERS2, which keyed "
+                 "deputies refuse");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("viewer", common.log_level);
   aerie::util::map_large_blocks();  // util/heap.hpp
@@ -79,6 +86,13 @@ int main(int argc, char** argv) {
     aerie::bus::Bus bus(common.lcm_url);
     aerie::viewer::Viewer viewer(bus, opts);
     viewer.add_default_renderers();
+    if (!key_path.empty()) {
+      const aerie::seal::SecretKey key = aerie::seal::load_key(key_path);  // refuses a file others can read
+      uint32_t id = 0;
+      while (id == 0) id = static_cast<uint32_t>(std::random_device{}() & 0x7fffffff);
+      if (auto* panel = dynamic_cast<aerie::viewer::ProcmanPanel*>(viewer.find("processes"))) panel->use_key(key, id);
+      spdlog::info("process panel: keyed orders (key {}, sheriff id {})", aerie::seal::fingerprint(key), id);
+    }
     for (const auto& name : disable) {
       auto* r = viewer.find(name);
       if (!r) {

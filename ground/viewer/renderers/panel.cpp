@@ -1,5 +1,7 @@
 #include "ground/viewer/renderers/panel.hpp"
 
+#include "procman/channels.hpp"
+
 #include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
@@ -226,8 +228,19 @@ bool ProcmanPanel::toggle_selected() {
     const bool running = c.last.pid != 0;
     orders = orders_for(report, c.sheriff_id, !running, util::wall_utime(), "aerie-viewer");
   }
-  bus_->publish("PMD_ORDERS2", orders);
+  if (signer_) {
+    const auto sealed = signer_->sign(orders, util::wall_utime());
+    bus_->publish_raw(procman::kSealedOrdersChannel, sealed.data(), sealed.size());
+  } else {
+    bus_->publish("PMD_ORDERS2", orders);
+  }
   return true;
+}
+
+void ProcmanPanel::use_key(const seal::SecretKey& mission_key, uint32_t sheriff) {
+  std::lock_guard lock(m_);
+  signer_ = std::make_unique<procman::OrdersSigner>(mission_key, sheriff);
+  ++version_;
 }
 
 bool ProcmanPanel::on_key(const std::string& key) {
@@ -269,7 +282,9 @@ std::string ProcmanPanel::text() const {
                   c.reported ? static_cast<double>(c.last.mem_rss_bytes) / 1048576.0 : 0.0, c.restarts);
     s += line;
   }
-  if (!cmds.empty()) s += "  [ ] select   s start/stop\n";
+  if (!cmds.empty())
+    s += signer_ ? "  [ ] select   s start/stop (keyed orders)\n"
+                 : "  [ ] select   s start/stop (plain: keyed deputies refuse; --key)\n";
   if (!nodes_.empty()) s += "\nnode          health\n";
   static const char* health[] = {"ok", "WARN", "ERROR"};
   for (const auto& [channel, m] : nodes_) {

@@ -6,9 +6,12 @@
 // the key fingerprint per half, INSECURE or a fingerprint mismatch in red) and for the
 // autopilot as aerie-mavlink hears it (AUTOPILOT_STATE, docs/mavlink.md).
 //
-// Start/stop works as a libbot2 sheriff does: the panel sends PMD_ORDERS2 for that
-// deputy built from its latest report, with only the selected command changed. While an
-// `aerie-sheriff` (not in observer mode) runs, its own orders prevail: use it to control.
+// Start/stop works as a sheriff does: the panel sends orders for that deputy built from its
+// latest report, with only the selected command changed -- tagged with the mission key on
+// PMD_ORDERS2_SEALED when the viewer has one (aerie-viewer --key; procman/orders_auth.hpp, as a
+// keyed aerie-sheriff), else libbot2's plain PMD_ORDERS2, which keyed deputies refuse (the
+// panel says so). While an `aerie-sheriff` (not in observer mode) runs, its own orders
+// prevail (a keyed deputy follows one sheriff): use it to control.
 #include <aerie/autopilot_state_t.hpp>
 #include <aerie/process_status_t.hpp>
 #include <bot_procman/info2_t.hpp>
@@ -23,6 +26,7 @@
 #include <vector>
 
 #include "ground/viewer/renderer.hpp"
+#include "procman/orders_auth.hpp"
 #include "procman/sheriff.hpp"
 
 class vtkRenderer;
@@ -53,6 +57,9 @@ class ProcmanPanel : public Renderer {
   static std::vector<Line> autopilot_lines(const aerie::autopilot_state_t& s, double age_s);
   // Sends orders that start (or stop) the selected command; false when none is selected.
   bool toggle_selected();
+  // Tag the orders as a keyed sheriff (`sheriff` != 0; from the mission key) from now on.
+  void use_key(const seal::SecretKey& mission_key, uint32_t sheriff);
+  bool keyed() const { return signer_ != nullptr; }
   size_t selected() const { return selected_; }
 
   // The orders that change only command `sheriff_id` of the reporting deputy: start it
@@ -66,6 +73,7 @@ class ProcmanPanel : public Renderer {
  private:
   std::string status_channels_, autopilot_channel_;
   bus::Bus* bus_ = nullptr;
+  std::unique_ptr<procman::OrdersSigner> signer_;
   mutable std::mutex m_;
   procman::Sheriff observer_{"aerie-viewer", true};
   std::map<std::string, aerie::process_status_t> nodes_;

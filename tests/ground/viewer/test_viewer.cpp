@@ -6,6 +6,7 @@
 #include <dlfcn.h>
 #include <link.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -24,9 +25,12 @@
 #include <vtkImageData.h>
 #include <vtkWindowToImageFilter.h>
 
+#include "air/track/factory.hpp"
+#include "air/track/node/default_tracker.hpp"
 #include "common/image/image_message.hpp"
 #include "common/util/time.hpp"
 #include "ground/map/octomap_message.hpp"
+#include "procman/channels.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -462,13 +466,33 @@ TEST_F(Fixture, ProcmanPanelShowsDeputyCommandsAndStartsOrStopsTheSelectedOne) {
   EXPECT_EQ(start.cmds[1].desired_runid, 1);  // a new run
   EXPECT_EQ(start.cmds[1].force_quit, 0);
 
+  std::vector<std::vector<uint8_t>> sealed;
+  bus.subscribe_raw(procman::kSealedOrdersChannel, [&](const uint8_t* d, size_t n, const bus::ReceiveInfo&) {
+    sealed.emplace_back(d, d + n);
+  });
+  EXPECT_FALSE(panel->keyed());
+  EXPECT_NE(panel->text().find("keyed deputies refuse"), std::string::npos) << panel->text();
   viewer->on_key("s");  // the selected command is "capture", running: stop it
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  // With the mission key the same orders go tagged, as a keyed sheriff's, and never plain.
+  const seal::SecretKey key = seal::SecretKey::generate();
+  panel->use_key(key, 77);
+  EXPECT_NE(panel->text().find("keyed orders"), std::string::npos) << panel->text();
+  viewer->on_key("s");
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   viewer->stop();
   ASSERT_EQ(orders.size(), 1u);
   EXPECT_EQ(orders[0].host, "air");
   ASSERT_EQ(orders[0].ncmds, 2);
   EXPECT_EQ(orders[0].cmds[0].force_quit, 1);
+  ASSERT_EQ(sealed.size(), 1u);
+  procman::VerifiedOrders v;
+  std::string why;
+  ASSERT_EQ(procman::verify_sealed_orders(procman::derive_orders_key(key), sealed[0], v, &why),
+            procman::OrdersRefusal::None) << why;
+  EXPECT_EQ(v.sender, 77u);
+  EXPECT_EQ(v.orders.host, "air");
+  EXPECT_EQ(v.orders.cmds[0].force_quit, 1);
 }
 
 TEST_F(Fixture, PublishesItsStatusWithTheHeapAndTrimsIt) {
@@ -647,4 +671,19 @@ TEST_F(Fixture, PanelShowsTheDoorAndTheAutopilotFromTheirChannelsInRedWhenInsecu
   if (const char* keep = std::getenv("AERIE_VIEWER_KEEP_SNAPSHOT")) cv::imwrite(std::string(keep) + "/insecure.png", img);
   // The door's own status lines are still listed with the other nodes below.
   EXPECT_NE(panel->text().find("link-air"), std::string::npos) << panel->text();
+}
+
+// Issue 49: the 't' cycle could not reach eco (aerie-track's default) or dcf, and a drag asked
+// for amcmr-ct. It starts with the node's default and holds every tracker of the factory once.
+TEST(TrackerCycle, StartsWithTheNodesDefaultAndReachesEveryTracker) {
+  const std::vector<std::string> cycle = viewer::tracker_cycle();
+  ASSERT_FALSE(cycle.empty());
+  EXPECT_EQ(cycle.front(), "eco");
+  EXPECT_EQ(cycle.front(), track::kDefaultTracker);
+  EXPECT_EQ(viewer::ViewerOptions{}.trackers, cycle);
+  std::vector<std::string> every = track::aerie_tracker_names();
+  for (const auto& name : track::opencv_tracker_names()) every.push_back(name);
+  EXPECT_EQ(cycle.size(), every.size());
+  for (const auto& name : every) EXPECT_EQ(std::count(cycle.begin(), cycle.end(), name), 1) << name;
+  EXPECT_EQ(std::count(cycle.begin(), cycle.end(), "dcf"), 1);
 }
