@@ -1,7 +1,8 @@
 // aerie-bench-vo: runs the stereo VO on a KITTI odometry folder, an EuRoC ASL folder or a
 // simulated flight, writes the trajectory (TUM) and scores it against the ground truth
 // (ATE after SE3 alignment, RPE per frame and over segments, per-axis RMSE, end-point
-// drift), with the thread CPU time of every stage.
+// drift, printed only for a loop: eval::is_loop), with the thread CPU time of every stage.
+// Ground truth comes from the dataset's own layout (eval::kGroundTruthLayouts) or --groundtruth.
 #include <CLI/CLI.hpp>
 #include <opencv2/core/utility.hpp>
 
@@ -36,11 +37,12 @@ struct Source {
   double path_m = 0;  // ground-truth path length known in advance (sim), else 0
 };
 
-Source open_dataset(const std::string& spec, bool exact_depth) {
+Source open_dataset(const std::string& spec, const std::string& groundtruth, bool exact_depth) {
   Source s;
   const auto colon = spec.find(':');
   const std::string kind = spec.substr(0, colon), arg = colon == std::string::npos ? "" : spec.substr(colon + 1);
   if (kind == "sim") {
+    if (!groundtruth.empty()) throw std::invalid_argument("--groundtruth: a sim: dataset has its own ground truth");
     const util::Config cfg = arg.empty() ? util::Config() : util::Config::load(arg);
     sim::WorldConfig wc;
     wc.seed = cfg.get<uint64_t>("world.seed", wc.seed);
@@ -80,7 +82,7 @@ Source open_dataset(const std::string& spec, bool exact_depth) {
     };
     return s;
   }
-  std::shared_ptr<eval::StereoSequence> seq = eval::open_sequence(spec);
+  std::shared_ptr<eval::StereoSequence> seq = eval::open_sequence(spec, groundtruth);
   const auto& rig = seq->rig();
   s.cam = {rig.fx, rig.fy, rig.cx, rig.cy, rig.baseline, rig.size.width, rig.size.height};
   s.frames = seq->size();
@@ -109,11 +111,18 @@ struct Mean {
 
 int main(int argc, char** argv) {
   CLI::App app{"Stereo VO evaluation on KITTI / EuRoC folders or a simulated flight"};
-  std::string dataset, config, out = "vo_trajectory.txt", json_path, plot;
+  app.footer(std::string("Ground truth found by itself: ") + eval::kGroundTruthLayouts +
+             "; any other file with --groundtruth.");
+  std::string dataset, groundtruth, config, out = "vo_trajectory.txt", json_path, plot;
   size_t max_frames = 0;
   double rpe_delta_m = 0;
   bool ba_sync = true, exact_depth = false;
   app.add_option("--dataset", dataset, "kitti:DIR, euroc:DIR or sim:CONFIG.yaml")->required();
+  app.add_option("--groundtruth", groundtruth,
+                 std::string("ground truth instead of the folder's own, format detected from the content: ") +
+                     eval::kTrajectoryFormats + "; kitti: the left camera's poses (KITTI poses stamped by "
+                     "times.txt), euroc: the body's (TUM or EuRoC CSV)")
+      ->check(CLI::ExistingFile);
   app.add_option("-c,--config", config, "VO configuration (config/vo.yaml format)")->check(CLI::ExistingFile);
   app.add_option("--out", out, "trajectory output (TUM: t x y z qx qy qz qw)");
   app.add_option("--json", json_path, "results as JSON");
@@ -123,7 +132,12 @@ int main(int argc, char** argv) {
   app.add_option("--ba-sync", ba_sync, "wait for each bundle adjustment (reproducible figures; false = as flown)");
   app.add_flag("--exact-depth", exact_depth, "sim only: use the renderer's exact disparity instead of SGBM_F "
                                           "(separates depth errors from tracking errors)");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);  // prints the help or the error
+    return rc == 0 ? 0 : 2;
+  }
   // Single thread: the stage timings are thread CPU time, which would miss work that OpenCV
   // hands to its pool. The bundle adjuster keeps its own thread.
   cv::setNumThreads(1);
@@ -131,7 +145,7 @@ int main(int argc, char** argv) {
     stereo::VoParams params =
         config.empty() ? stereo::VoParams{} : stereo::vo_params_from_config(util::Config::load(config), stereo::kNodeSections);
     params.ba_synchronous = ba_sync;
-    Source src = open_dataset(dataset, exact_depth);
+    Source src = open_dataset(dataset, groundtruth, exact_depth);
     if (exact_depth && dataset.rfind("sim:", 0) != 0) throw std::runtime_error("--exact-depth needs a sim: dataset");
     stereo::StereoOdometry vo(src.cam, params);
     std::cout << src.name << ": " << src.frames << " frames " << src.cam.width << "x" << src.cam.height
@@ -228,7 +242,8 @@ int main(int argc, char** argv) {
       }
     } else {
       const eval::Drift d = eval::end_point_drift({}, est);
-      std::cout << "no ground truth; end point " << d.loop_closure_m << " m from the start\n";
+      std::cout << "no ground truth (" << eval::kGroundTruthLayouts
+                << "; or give --groundtruth FILE); end point " << d.loop_closure_m << " m from the start\n";
       js << ", \"end_point_m\": " << d.loop_closure_m;
     }
     js << "}\n";

@@ -1,5 +1,5 @@
 // aerie-eval-traj: scores an estimated trajectory against a reference (ATE, RPE,
-// per-axis RMSE, end-point drift), evo-compatible, TUM or KITTI files.
+// per-axis RMSE, end-point drift), evo-compatible, TUM, EuRoC CSV or KITTI files.
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
@@ -7,8 +7,10 @@
 #include "tools/eval/report.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"Trajectory evaluation: ATE after alignment, RPE per frame and over path segments, per-axis RMSE, "
-               "end-point drift. Files are TUM (t x y z qx qy qz qw) or KITTI (12 numbers per line)."};
+  CLI::App app{std::string("Trajectory evaluation: ATE after alignment, RPE per frame and over path segments, "
+                           "per-axis RMSE, end-point drift (loop drift for loops only). Files, detected from the "
+                           "content: ") +
+               aerie::eval::kTrajectoryFormats + "."};
   std::string ref_path, est_path, ref_times, est_times, alignment = "se3", json_path;
   aerie::eval::ReportOptions opt;
   app.add_option("--ref", ref_path, "reference (ground-truth) trajectory")->required()->check(CLI::ExistingFile);

@@ -179,11 +179,18 @@ AxisRmse per_axis_rmse(const Trajectory& ref, const Trajectory& aligned_est) {
   return out;
 }
 
+bool is_loop(const Trajectory& t) {
+  if (t.empty()) return false;
+  const double gap = (t.poses.back().translation() - t.poses.front().translation()).norm();
+  return gap <= std::max(kLoopRadiusM, kLoopPathFraction * t.path_length());
+}
+
 Drift end_point_drift(const Trajectory& ref, const Trajectory& est) {
   if (est.empty()) throw std::invalid_argument("drift: empty estimate");
   Drift d;
   const Eigen::Vector3d est_end = (est.poses.front().inverse() * est.poses.back()).translation();
   d.loop_closure_m = est_end.norm();
+  d.loop = is_loop(ref.empty() ? est : ref);
   if (!ref.empty()) {
     require_same_length(ref, est, "drift");
     const Eigen::Vector3d ref_end = (ref.poses.front().inverse() * ref.poses.back()).translation();

@@ -65,10 +65,17 @@ AxisRmse per_axis_rmse(const Trajectory& ref, const Trajectory& aligned_est);
 // Roll, pitch, yaw (rad) of R = Rz(yaw) Ry(pitch) Rx(roll).
 Eigen::Vector3d roll_pitch_yaw(const Eigen::Matrix3d& R);
 
+// A loop: the trajectory ends within max(kLoopRadiusM, kLoopPathFraction * path length) of its
+// start (a sequence standing still is one). Only then is the end point's distance from the start
+// a drift (eq. 4.18).
+inline constexpr double kLoopRadiusM = 0.5, kLoopPathFraction = 0.1;
+bool is_loop(const Trajectory& t);
+
 // End-point drift: |p_end - p_start| of the estimate relative to its first pose (eq. 4.18, for
 // loops returning to the start) and, when a reference is given, |p_end_est - p_end_ref| with
 // both expressed in their first pose's frame.
 struct Drift {
+  bool loop = false;           // is_loop of the reference (of the estimate if no reference)
   double loop_closure_m = 0;   // sqrt(X_F^2 + Y_F^2 + Z_F^2), est end in est start frame
   double vs_reference_m = 0;   // est end vs ref end, both relative to their start
   double distance_m = 0;       // reference path length (estimate's if no reference)

@@ -62,9 +62,12 @@ void print(std::ostream& os, const Report& r, const ReportOptions& opt) {
   os << std::setprecision(1) << "per-axis RMSE            x " << r.axes.position.x() * 1e3 << " mm  y "
      << r.axes.position.y() * 1e3 << " mm  z " << r.axes.position.z() * 1e3 << " mm   roll " << std::setprecision(3)
      << r.axes.rpy_deg.x() << " deg  pitch " << r.axes.rpy_deg.y() << " deg  yaw " << r.axes.rpy_deg.z() << " deg\n";
-  os << std::setprecision(4) << "end point                loop drift " << r.drift.loop_closure_m
-     << " m   vs reference " << r.drift.vs_reference_m << " m = " << std::setprecision(3) << r.drift.percent()
-     << " % of " << r.drift.distance_m << " m\n";
+  os << std::setprecision(4) << "end point                ";
+  if (r.drift.loop) os << "loop drift " << r.drift.loop_closure_m << " m   ";
+  os << "vs reference " << r.drift.vs_reference_m << " m = " << std::setprecision(3) << r.drift.percent() << " % of "
+     << r.drift.distance_m << " m";
+  if (!r.drift.loop) os << "   (not a loop: its end is far from its start)";
+  os << '\n';
 }
 
 std::string to_json(const Report& r, const ReportOptions& opt) {
@@ -78,7 +81,9 @@ std::string to_json(const Report& r, const ReportOptions& opt) {
     os << ", \"rpe_delta_m\": " << opt.rpe_delta_m << ", \"rpe_path_trans_m\": " << json(r.rpe_path_trans);
   os << ", \"rmse_xyz_m\": [" << r.axes.position.x() << ", " << r.axes.position.y() << ", " << r.axes.position.z()
      << "], \"rmse_rpy_deg\": [" << r.axes.rpy_deg.x() << ", " << r.axes.rpy_deg.y() << ", " << r.axes.rpy_deg.z()
-     << "], \"loop_drift_m\": " << r.drift.loop_closure_m << ", \"end_drift_m\": " << r.drift.vs_reference_m
+     << "], \"loop\": " << (r.drift.loop ? "true" : "false");
+  if (r.drift.loop) os << ", \"loop_drift_m\": " << r.drift.loop_closure_m;
+  os << ", \"end_drift_m\": " << r.drift.vs_reference_m
      << ", \"end_drift_percent\": " << r.drift.percent() << "}";
   return os.str();
 }

@@ -25,7 +25,7 @@ cv::Mat read_gray(const fs::path& p) {
 
 class KittiSequence final : public StereoSequence {
  public:
-  explicit KittiSequence(const fs::path& dir) {
+  KittiSequence(const fs::path& dir, const std::string& groundtruth) {
     name_ = dir.filename().string();
     for (const auto& [l, r] : {std::pair{"image_0", "image_1"}, std::pair{"image_l", "image_r"}})
       if (fs::is_directory(dir / l) && fs::is_directory(dir / r)) {
@@ -51,13 +51,20 @@ class KittiSequence final : public StereoSequence {
     }
     for (size_t i = 0; i < files_.size(); ++i)
       utimes_.push_back(times.empty() ? static_cast<int64_t>(i) * 100000 : std::llround(times[i] * 1e6));
-    if (fs::exists(dir / "poses.txt")) {
-      ground_truth_ = read_kitti_poses((dir / "poses.txt").string());
-      if (ground_truth_.size() < files_.size())
-        throw std::runtime_error((dir / "poses.txt").string() + ": fewer poses than images");
-      ground_truth_.poses.resize(files_.size());
-      ground_truth_.stamps.resize(files_.size());
-      for (size_t i = 0; i < files_.size(); ++i) ground_truth_.stamps[i] = static_cast<double>(utimes_[i]) * 1e-6;
+    // Ground truth of the left camera: KITTI poses are one line per frame, stamped here with
+    // the frames' times (times.txt); TUM and EuRoC CSV files carry their own (seconds of times.txt).
+    const fs::path gt = !groundtruth.empty() ? fs::path(groundtruth) : dir / "poses.txt";
+    if (!groundtruth.empty() || fs::exists(gt)) {
+      TrajectoryFormat format;
+      ground_truth_ = read_trajectory(gt.string(), "", &format);
+      if (format == TrajectoryFormat::KittiPoses) {
+        if (ground_truth_.size() < files_.size())
+          throw std::runtime_error(gt.string() + ": " + std::to_string(ground_truth_.size()) +
+                                   " KITTI poses for " + std::to_string(files_.size()) + " images (one per frame)");
+        ground_truth_.poses.resize(files_.size());
+        ground_truth_.stamps.resize(files_.size());
+        for (size_t i = 0; i < files_.size(); ++i) ground_truth_.stamps[i] = static_cast<double>(utimes_[i]) * 1e-6;
+      }
     }
   }
   void load(size_t i, cv::Mat& left, cv::Mat& right) const override {
@@ -70,28 +77,9 @@ class KittiSequence final : public StereoSequence {
   std::unique_ptr<camera::StereoRectifier> rectifier_;
 };
 
-// EuRoC's state_groundtruth_estimate0/data.csv: t[ns], p xyz, q wxyz, ...
-Trajectory read_euroc_groundtruth_csv(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot open");
-  Trajectory t;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream ss(line);
-    double ns, v[7];
-    if (!(ss >> ns >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5] >> v[6]))
-      throw std::runtime_error(path.string() + ": malformed line '" + line.substr(0, 60) + "'");
-    const double q[4] = {v[3], v[4], v[5], v[6]}, p[3] = {v[0], v[1], v[2]};
-    t.push_back(ns * 1e-9, geometry::SE3::from_wxyz(q, p));
-  }
-  return t;
-}
-
 class EurocSequence final : public StereoSequence {
  public:
-  explicit EurocSequence(const fs::path& dir) {
+  EurocSequence(const fs::path& dir, const std::string& groundtruth) {
     name_ = dir.filename().string();
     const fs::path mav0 = fs::exists(dir / "mav0") ? dir / "mav0" : dir;
     if (!fs::exists(mav0 / "cam0" / "data.csv"))
@@ -118,13 +106,18 @@ class EurocSequence final : public StereoSequence {
 
     // Ground truth: body (IMU) poses -> rectified left camera: T_w_rect = T_w_b T_b_cam0 T_cam0_rect.
     Trajectory body;
-    for (const auto& cand : {dir / "groundtruth"}) {
-      if (!fs::is_directory(cand)) continue;
-      for (const auto& e : fs::directory_iterator(cand))
-        if (e.path().extension() == ".txt") body = read_tum(e.path().string());
+    if (!groundtruth.empty()) {
+      TrajectoryFormat format;
+      body = read_trajectory(groundtruth, "", &format);
+      if (format == TrajectoryFormat::KittiPoses)
+        throw std::runtime_error(groundtruth + ": KITTI poses have no timestamps; a EuRoC sequence needs TUM or "
+                                 "EuRoC CSV ground truth of the body");
     }
+    if (body.empty() && fs::is_directory(dir / "groundtruth"))
+      for (const auto& e : fs::directory_iterator(dir / "groundtruth"))
+        if (e.path().extension() == ".txt") body = read_tum(e.path().string());
     if (body.empty() && fs::exists(mav0 / "state_groundtruth_estimate0" / "data.csv"))
-      body = read_euroc_groundtruth_csv(mav0 / "state_groundtruth_estimate0" / "data.csv");
+      body = read_euroc_csv((mav0 / "state_groundtruth_estimate0" / "data.csv").string());
     if (!body.empty()) {
       const auto cam0 = camera::read_euroc_camera((mav0 / "cam0" / "sensor.yaml").string());
       const cv::Matx33d R1 = rectifier_->R_left();
@@ -147,14 +140,18 @@ class EurocSequence final : public StereoSequence {
 
 }  // namespace
 
-std::unique_ptr<StereoSequence> open_kitti(const std::string& dir) { return std::make_unique<KittiSequence>(dir); }
-std::unique_ptr<StereoSequence> open_euroc(const std::string& dir) { return std::make_unique<EurocSequence>(dir); }
+std::unique_ptr<StereoSequence> open_kitti(const std::string& dir, const std::string& groundtruth) {
+  return std::make_unique<KittiSequence>(dir, groundtruth);
+}
+std::unique_ptr<StereoSequence> open_euroc(const std::string& dir, const std::string& groundtruth) {
+  return std::make_unique<EurocSequence>(dir, groundtruth);
+}
 
-std::unique_ptr<StereoSequence> open_sequence(const std::string& spec) {
+std::unique_ptr<StereoSequence> open_sequence(const std::string& spec, const std::string& groundtruth) {
   const auto colon = spec.find(':');
   const std::string kind = spec.substr(0, colon), dir = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  if (kind == "kitti") return open_kitti(dir);
-  if (kind == "euroc") return open_euroc(dir);
+  if (kind == "kitti") return open_kitti(dir, groundtruth);
+  if (kind == "euroc") return open_euroc(dir, groundtruth);
   throw std::invalid_argument("dataset '" + spec + "': expected kitti:DIR or euroc:DIR");
 }
 

@@ -5,6 +5,9 @@
 //  * EuRoC ASL folders: mav0/cam0, mav0/cam1 (data.csv + raw distorted PNGs, sensor.yaml),
 //    rectified here with common/camera; ground truth from groundtruth/*.txt (TUM) or
 //    mav0/state_groundtruth_estimate0/data.csv, turned into poses of the rectified left camera.
+// An explicit ground-truth file (any format read_trajectory detects) replaces those: for KITTI
+// the left camera's poses (KITTI poses stamped with times.txt), for EuRoC the body's (TUM or
+// EuRoC CSV).
 // Images come out rectified and 8-bit gray.
 #include <cstdint>
 #include <memory>
@@ -37,9 +40,15 @@ class StereoSequence {
   std::vector<int64_t> utimes_;
 };
 
-std::unique_ptr<StereoSequence> open_kitti(const std::string& dir);
-std::unique_ptr<StereoSequence> open_euroc(const std::string& dir);
+// Where the readers find ground truth by themselves, for help texts and messages.
+inline constexpr const char* kGroundTruthLayouts =
+    "kitti:DIR reads DIR/poses.txt; euroc:DIR reads DIR/groundtruth/*.txt (TUM) or "
+    "DIR/mav0/state_groundtruth_estimate0/data.csv";
+
+// groundtruth: "" = the layouts above.
+std::unique_ptr<StereoSequence> open_kitti(const std::string& dir, const std::string& groundtruth = "");
+std::unique_ptr<StereoSequence> open_euroc(const std::string& dir, const std::string& groundtruth = "");
 // "kitti:DIR" or "euroc:DIR".
-std::unique_ptr<StereoSequence> open_sequence(const std::string& spec);
+std::unique_ptr<StereoSequence> open_sequence(const std::string& spec, const std::string& groundtruth = "");
 
 }  // namespace aerie::eval

@@ -1,5 +1,6 @@
 #include "tools/eval/trajectory.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -9,7 +10,9 @@
 namespace aerie::eval {
 namespace {
 
-std::vector<std::vector<double>> read_numbers(const std::string& path) {
+// The numbers of each data row ('#' comments and blank lines skipped, commas as spaces);
+// `lines` (optional) receives each row's line number in the file.
+std::vector<std::vector<double>> read_numbers(const std::string& path, std::vector<int>* lines = nullptr) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::vector<std::vector<double>> rows;
@@ -36,6 +39,7 @@ std::vector<std::vector<double>> read_numbers(const std::string& path) {
     for (double v : row)
       if (!std::isfinite(v)) throw std::runtime_error(path + ":" + std::to_string(lineno) + ": value is not finite");
     rows.push_back(std::move(row));
+    if (lines) lines->push_back(lineno);
   }
   return rows;
 }
@@ -126,13 +130,69 @@ void write_kitti_poses(const Trajectory& traj, const std::string& path) {
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
-Trajectory read_trajectory(const std::string& path) {
-  const auto rows = read_numbers(path);
+const char* format_name(TrajectoryFormat f) {
+  switch (f) {
+    case TrajectoryFormat::Tum: return "TUM";
+    case TrajectoryFormat::EurocCsv: return "EuRoC CSV";
+    case TrajectoryFormat::KittiPoses: return "KITTI poses";
+  }
+  return "?";
+}
+
+namespace {
+
+// A timestamp in nanoseconds (EuRoC) rather than seconds (TUM): an integer beyond 1e12
+// (1e12 s would be 31 700 years; 1e12 ns is 17 minutes after the epoch).
+bool is_nanoseconds(double t) { return t >= 1e12 && t == std::floor(t); }
+
+TrajectoryFormat detect(const std::string& path, const std::vector<std::vector<double>>& rows,
+                        const std::vector<int>& lines) {
   if (rows.empty()) throw std::runtime_error(path + ": no poses");
-  if (rows.front().size() == 12) return read_kitti_poses(path);
-  if (rows.front().size() == 8) return read_tum(path);
-  throw std::runtime_error(path + ": rows have " + std::to_string(rows.front().size()) +
-                           " numbers; expected 8 (TUM) or 12 (KITTI)");
+  const auto& r = rows.front();
+  if (r.size() == 12) return TrajectoryFormat::KittiPoses;
+  if (r.size() >= 8 && is_nanoseconds(r[0])) return TrajectoryFormat::EurocCsv;
+  if (r.size() == 8) return TrajectoryFormat::Tum;
+  throw std::runtime_error(path + ":" + std::to_string(lines.front()) + ": " + std::to_string(r.size()) +
+                           " numbers in the first pose; expected " + kTrajectoryFormats);
+}
+
+}  // namespace
+
+TrajectoryFormat detect_trajectory_format(const std::string& path) {
+  std::vector<int> lines;
+  const auto rows = read_numbers(path, &lines);
+  return detect(path, rows, lines);
+}
+
+Trajectory read_euroc_csv(const std::string& path) {
+  std::vector<int> lines;
+  const auto rows = read_numbers(path, &lines);
+  Trajectory traj;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    const std::string where = path + ":" + std::to_string(lines[i]);
+    if (r.size() != rows.front().size() || r.size() < 8)
+      throw std::runtime_error(where + ": " + std::to_string(r.size()) + " numbers; a EuRoC CSV row has " +
+                               std::to_string(std::max<size_t>(8, rows.front().size())) +
+                               " (t[ns], p xyz, q wxyz, ...)");
+    if (!is_nanoseconds(r[0])) throw std::runtime_error(where + ": timestamp is not in nanoseconds (EuRoC CSV)");
+    const double wxyz[4] = {r[4], r[5], r[6], r[7]};
+    const double t[3] = {r[1], r[2], r[3]};
+    traj.push_back(r[0] * 1e-9, geometry::SE3::from_wxyz(wxyz, t));
+  }
+  return traj;
+}
+
+Trajectory read_trajectory(const std::string& path, const std::string& kitti_times, TrajectoryFormat* found) {
+  std::vector<int> lines;
+  const TrajectoryFormat f = detect(path, read_numbers(path, &lines), lines);
+  if (found) *found = f;
+  switch (f) {
+    case TrajectoryFormat::KittiPoses: return read_kitti_poses(path, kitti_times);
+    case TrajectoryFormat::EurocCsv: return read_euroc_csv(path);
+    case TrajectoryFormat::Tum: break;
+  }
+  return read_tum(path);
 }
 
 Associated associate(const Trajectory& ref, const Trajectory& est, double max_dt) {
