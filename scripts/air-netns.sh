@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# One door on the air host (issue 46 section 1; docs/security.md "Deployment: one door"): the
-# air nodes run in a network namespace that has only loopback, the radio interface lives in
-# another namespace where only the door's air half runs, and the air half holds one socket in
-# each -- its sealed UDP socket on the radio, its LCM sockets among the nodes (aerie-link
-# --lcm-netns). Nothing but the door's port is reachable from the radio, by multicast or
-# unicast: the nodes' namespace has no interface but loopback.
+# One door per host (issue 46 section 1; docs/security.md "Deployment: one door"): the nodes run
+# in a network namespace that has only loopback, the radio (or LAN) interface lives in another
+# namespace where only the door's half runs, and the half holds one socket in each -- its sealed
+# UDP socket on the radio, its LCM sockets among the nodes (aerie-link --lcm-netns). Nothing but
+# the door's port is reachable from the radio, by multicast or unicast: the nodes' namespace has
+# no interface but loopback. The air host runs it with the air half (the default); the ground
+# station with --half ground, so that no one on the radio or the ground LAN can put a command on
+# the ground's LCM for the ground half to sign with the operator's key.
 #
 #   sudo scripts/air-netns.sh up --radio wlan0        # namespaces; wlan0 moves into the radio one
 #   sudo scripts/air-netns.sh door -- --key /etc/aerie/mission.key --operator-pub /etc/aerie/operator.key.pub \
@@ -12,17 +14,19 @@
 #   sudo scripts/air-netns.sh nodes -- aerie-deputy --name air      # any air node (procman's deputy, ...)
 #   sudo scripts/air-netns.sh check                   # refuses a topology that is not one door
 #   sudo scripts/air-netns.sh down                    # the radio back to the host, namespaces removed
+#   sudo scripts/air-netns.sh up --half ground --radio eth0 ...   # the same on the ground station
 #
-# Needs root and iproute2. `door` runs aerie-link --half air --config config/link.yaml (give
-# more options after --); `nodes` runs its command in the nodes' namespace.
+# Needs root and iproute2. `door` runs aerie-link --half air|ground --config config/link.yaml
+# (give more options after --); `nodes` runs its command in the nodes' namespace.
 set -euo pipefail
 
 usage() {
-  sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'
   cat <<EOF
-Options (before the command's own arguments):
-  --nodes-ns NAME   the air nodes' namespace (default: aerie-air)
-  --radio-ns NAME   the radio's namespace (default: aerie-radio)
+Options (after the command, before -- and the command's own arguments):
+  --half H          air (default) or ground: which half the door runs, and the default names
+  --nodes-ns NAME   the nodes' namespace (default: aerie-air; aerie-ground with --half ground)
+  --radio-ns NAME   the radio's namespace (default: aerie-radio; aerie-lan with --half ground)
   --radio IFACE     (up) the radio interface to move into the radio namespace
   --address CIDR    (up) an address for the radio interface there (e.g. 10.0.0.1/24)
   --bin DIR         Aerie executables (default: build/default/bin)
@@ -35,14 +39,17 @@ die() { echo "air-netns: $*" >&2; exit 1; }
 [[ $# -ge 1 ]] || { usage; exit 2; }
 CMD=$1
 shift
-NODES=aerie-air
-RADIO=aerie-radio
+case "$CMD" in -h|--help) usage; exit 0 ;; esac
+HALF=air
+NODES=
+RADIO=
 IFACE=
 ADDRESS=
 BIN=${AERIE_BIN:-build/default/bin}
 CONFIG=config/link.yaml
 while [[ $# -gt 0 ]]; do
   case "$1" in
+    --half) HALF=$2; shift ;;
     --nodes-ns) NODES=$2; shift ;;
     --radio-ns) RADIO=$2; shift ;;
     --radio) IFACE=$2; shift ;;
@@ -51,10 +58,16 @@ while [[ $# -gt 0 ]]; do
     --config) CONFIG=$2; shift ;;
     --) shift; break ;;
     -h|--help) usage; exit 0 ;;
-    *) die "unknown option '$1' (see --help)" ;;
+    *) echo "air-netns: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
 done
+
+case "$HALF" in
+  air) NODES=${NODES:-aerie-air}; RADIO=${RADIO:-aerie-radio} ;;
+  ground) NODES=${NODES:-aerie-ground}; RADIO=${RADIO:-aerie-lan} ;;
+  *) echo "air-netns: --half must be air or ground, not '$HALF'" >&2; exit 2 ;;
+esac
 
 [[ $(id -u) -eq 0 ]] || die "needs root for network namespaces (sudo $0 ...)"
 command -v ip >/dev/null || die "iproute2 'ip' is missing (apt-get install iproute2)"
@@ -106,7 +119,7 @@ case "$CMD" in
   door)
     exists "$NODES" && exists "$RADIO" || die "namespaces missing (air-netns.sh up first)"
     [[ -x $BIN/aerie-link ]] || die "$BIN/aerie-link not found: build first or give --bin"
-    exec ip netns exec "$RADIO" "$BIN/aerie-link" --half air --config "$CONFIG" \
+    exec ip netns exec "$RADIO" "$BIN/aerie-link" --half "$HALF" --config "$CONFIG" \
       --lcm-netns "/run/netns/$NODES" "$@"
     ;;
   nodes)

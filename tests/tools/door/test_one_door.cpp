@@ -1,12 +1,15 @@
 // Nothing but the door is reachable from the radio (issue 46 section 1; docs/security.md
-// "Deployment: one door"), as scripts/air-netns.sh deploys it, in namespaces the test creates
-// and removes (also on failure): "nodes" (the air nodes, loopback only), "radio" (the air
-// host's radio side, where only the air half runs, its LCM sockets opened in "nodes" with
-// --lcm-netns), and "ground", joined to "radio" by a veth pair. From "ground", forged
-// PILOT_CMD and PMD_ORDERS2 are sent as LCM would send them -- by multicast across the veth
-// and by unicast to the air side's radio address, port 7667 -- and reach no air node; only
-// the door's port is open there, and a forged datagram to it is refused and counted. The
-// operator's real ABORT, through the ground half, does reach the air nodes.
+// "Deployment: one door"), as scripts/air-netns.sh deploys it on both hosts, in namespaces the
+// test creates and removes (also on failure): "nodes" (the air nodes, loopback only), "radio"
+// (the air host's radio side, where only the air half runs, its LCM sockets opened in "nodes"
+// with --lcm-netns), "ground" (the ground station's radio side, only the ground half) joined to
+// "radio" by a veth pair, and "gnodes" (the ground's nodes, loopback only). From "ground",
+// forged PILOT_CMD and PMD_ORDERS2 are sent as LCM would send them -- by multicast across the
+// veth and by unicast to the air side's radio address, port 7667 -- and reach no air node;
+// from "radio", the same towards the ground station's port 7668 reach no ground node (which
+// the ground half would sign with the operator's key); only the doors' ports are open, and a
+// forged datagram to the air's is refused and counted. The operator's real ABORT, from the
+// ground's nodes through both halves, does reach the air nodes.
 #include <aerie/pilot_cmd_t.hpp>
 #include <aerie/process_status_t.hpp>
 #include <arpa/inet.h>
@@ -104,11 +107,13 @@ void multicast(const std::string& group, int port, const std::vector<uint8_t>& d
 TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
   if (const auto why = testbed::namespaces_unavailable(); !why.empty()) GTEST_SKIP() << why;
   const auto dir = test::scratch_dir("one-door");
+  // The ground station is deployed the same way: its nodes in "gnodes" (loopback only), its
+  // half in "ground", which holds the link to the radio.
   testbed::NetNamespace nodes(testbed::unique_name("nodes")), radio(testbed::unique_name("radio")),
-      ground(testbed::unique_name("ground"));
+      ground(testbed::unique_name("ground")), gnodes(testbed::unique_name("gnodes"));
   testbed::join_with_veth(radio, ground, 214);
   // The ground station's own LCM stays on its loopback (ttl=0).
-  testbed::run({"ip", "-n", ground.name(), "route", "add", "239.255.76.68/32", "dev", "lo"});
+  testbed::run({"ip", "-n", gnodes.name(), "route", "add", "239.255.76.68/32", "dev", "lo"});
   const std::string key = (dir / "mission.key").string();
   seal::save_key(key, seal::SecretKey::generate());
   const std::string op_key = (dir / "operator.key").string();
@@ -134,9 +139,11 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
     air->subscribe_raw("PMD_.*", [&](const uint8_t*, size_t, const bus::ReceiveInfo& i) { ++procman[i.channel]; });
     air->subscribe<aerie::process_status_t>("STATUS_LINK_AIR", [&](const auto& s, const auto&) { air_status = s; });
   }
+  std::vector<aerie::pilot_cmd_t> ground_pilot;  // what the ground's own nodes hear
   {
-    testbed::EnterNamespace inside(ground);
+    testbed::EnterNamespace inside(gnodes);
     gnd = std::make_unique<bus::Bus>(kGroundUrl);
+    gnd->subscribe<aerie::pilot_cmd_t>("PILOT_CMD", [&](const auto& m, const auto&) { ground_pilot.push_back(m); });
   }
   std::vector<std::string> air_half = {"bash", script, "door", "--nodes-ns", nodes.name(), "--radio-ns", radio.name(),
                                        "--bin", bin, "--config", cfg, "--", "--key", key,
@@ -144,10 +151,10 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
                                        "--lcm-url", kAirUrl, "--operator-pub", op_key + ".pub"};
   air_half.insert(air_half.end(), no_impairments.begin(), no_impairments.end());
   testbed::Process air_door(air_half, (dir / "air-half.log").string());
-  auto ground_half = ground.exec_prefix();
-  ground_half.insert(ground_half.end(), {bin + "/aerie-link", "--half", "ground", "--config", cfg, "--key", key,
-                                         "--listen", kGroundRadio + ":" + door, "--peer", kAirRadio + ":" + door,
-                                         "--lcm-url", kGroundUrl, "--operator-key", op_key});
+  std::vector<std::string> ground_half = {"bash", script, "door", "--half", "ground", "--nodes-ns", gnodes.name(),
+                                          "--radio-ns", ground.name(), "--bin", bin, "--config", cfg, "--", "--key", key,
+                                          "--listen", kGroundRadio + ":" + door, "--peer", kAirRadio + ":" + door,
+                                          "--lcm-url", kGroundUrl, "--operator-key", op_key};
   ground_half.insert(ground_half.end(), no_impairments.begin(), no_impairments.end());
   testbed::Process ground_door(ground_half, (dir / "ground-half.log").string());
   auto spin = [&](std::chrono::milliseconds d) {
@@ -163,6 +170,9 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
   // namespace only aerie-link listens.
   const std::string check = testbed::run({"bash", script, "check", "--nodes-ns", nodes.name(), "--radio-ns", radio.name()});
   EXPECT_NE(check.find("one door"), std::string::npos) << check;
+  const std::string ground_check = testbed::run(
+      {"bash", script, "check", "--half", "ground", "--nodes-ns", gnodes.name(), "--radio-ns", ground.name()});
+  EXPECT_NE(ground_check.find("one door"), std::string::npos) << ground_check;
 
   // The attacks, from the ground namespace.
   const auto forged_pilot = lcm_datagram("PILOT_CMD", encoded_abort(), 1);
@@ -180,9 +190,20 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
     // The door's port is open (no "unreachable"), and what it gets is refused.
     door_port_closed = port_closed(kAirRadio, kDoorPort, forged_pilot);
   }
+  // And towards the ground station, from the radio: a command put on the ground's LCM would be
+  // signed by the ground half with the operator's key. Nothing listens on 7668 there either.
+  bool ground_port_closed = false;
+  {
+    testbed::EnterNamespace inside(radio);
+    for (int i = 0; i < 5; ++i) multicast("239.255.76.68", 7668, forged_pilot);
+    ground_port_closed = port_closed(kGroundRadio, 7668, forged_pilot);
+  }
+  EXPECT_TRUE(ground_port_closed) << "something listens on " << kGroundRadio << ":7668";
   EXPECT_TRUE(pilot_port_closed) << "something listens on " << kAirRadio << ":7667";
   EXPECT_FALSE(door_port_closed) << "the door does not listen on " << kAirRadio << ":" << kDoorPort;
   spin(500ms);
+  gnd->handle(0);
+  EXPECT_TRUE(ground_pilot.empty()) << "a forged PILOT_CMD reached a ground node";
   EXPECT_TRUE(pilot.empty()) << "a forged PILOT_CMD reached an air node";
   EXPECT_TRUE(procman.empty()) << "a forged PMD_ORDERS2 reached an air node";
 
@@ -194,7 +215,7 @@ TEST(OneDoor, NothingButTheDoorIsReachableFromTheRadio) {
     m.command = aerie::pilot_cmd_t::ABORT;
     m.source = "operator";
     {
-      testbed::EnterNamespace inside(ground);
+      testbed::EnterNamespace inside(gnodes);
       gnd->publish("PILOT_CMD", m);
     }
     spin(50ms);
