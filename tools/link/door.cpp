@@ -171,9 +171,14 @@ bool DoorSender::hello_request(double now_s, std::vector<uint8_t>& out) { return
 
 bool DoorSender::send(std::string_view channel, std::span<const uint8_t> payload, double now_s,
                       std::vector<std::vector<uint8_t>>& out) {
+  out.clear();
+  return send(channel, payload, now_s, [&](std::span<const uint8_t> d) { out.emplace_back(d.begin(), d.end()); });
+}
+
+bool DoorSender::send(std::string_view channel, std::span<const uint8_t> payload, double now_s,
+                      const DatagramSink& out) {
   if (!seal::valid_channel(channel))
     throw std::invalid_argument("door: channel '" + std::string(channel) + "' is not a valid channel name");
-  out.clear();
   if (sealer_ && operator_channels_(std::string(channel))) {
     if (!signer_) {
       ++counters_.unsigned_commands;
@@ -191,7 +196,7 @@ bool DoorSender::send(std::string_view channel, std::span<const uint8_t> payload
 }
 
 bool DoorSender::split(std::string_view channel, std::span<const uint8_t> payload, double now_s,
-                       std::vector<std::vector<uint8_t>>& out) {
+                       const DatagramSink& out) {
   if (payload.size() > limits_.max_message_bytes) {
     ++counters_.too_large;
     return false;
@@ -202,8 +207,8 @@ bool DoorSender::split(std::string_view channel, std::span<const uint8_t> payloa
     frame_.resize(kWholeHeader + payload.size());
     frame_[0] = 0;
     if (!payload.empty()) std::memcpy(frame_.data() + 1, payload.data(), payload.size());
-    out.emplace_back();
-    emit(channel, frame_, now_s, out.back());
+    emit(channel, frame_, now_s, datagram_);
+    out(datagram_);
   } else {
     const size_t chunk = room - kFragmentHeader;
     const size_t count = (payload.size() + chunk - 1) / chunk;
@@ -222,9 +227,9 @@ bool DoorSender::split(std::string_view channel, std::span<const uint8_t> payloa
       put_u32(&frame_[9], static_cast<uint32_t>(payload.size()));
       put_u32(&frame_[13], static_cast<uint32_t>(off));
       std::memcpy(frame_.data() + kFragmentHeader, payload.data() + off, n);
-      out.emplace_back();
-      emit(channel, frame_, now_s, out.back());
+      emit(channel, frame_, now_s, datagram_);
       ++counters_.fragments;
+      out(datagram_);
     }
   }
   ++counters_.messages;

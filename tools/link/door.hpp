@@ -23,6 +23,7 @@
 // channel: a secure half refuses them ("insecure_peer") and an insecure half refuses sealed
 // datagrams ("secure_peer"), so a secure and an insecure half never connect.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -135,6 +136,11 @@ class DoorSender {
   // message is over max_message_bytes; throws std::invalid_argument for an invalid channel.
   bool send(std::string_view channel, std::span<const uint8_t> payload, double now_s,
             std::vector<std::vector<uint8_t>>& out);
+  // The same, handing each datagram to `sink` as soon as it is sealed (valid during the call):
+  // the halves send it at once, so that the far half opens one fragment while this one seals
+  // the next.
+  using DatagramSink = std::function<void(std::span<const uint8_t>)>;
+  bool send(std::string_view channel, std::span<const uint8_t> payload, double now_s, const DatagramSink& sink);
   // The ground half: messages on `operator_channels` (regex) are signed with `signer` for the
   // air half's session (set_session); without a signer they are refused and counted. Only a
   // secure sender signs (an insecure door authenticates nothing).
@@ -157,14 +163,13 @@ class DoorSender {
   void emit(std::string_view channel, std::span<const uint8_t> frame, double now_s, std::vector<uint8_t>& out);
 
   bool emit_hello(std::span<const uint8_t> body, double now_s, std::vector<uint8_t>& out);
-  bool split(std::string_view channel, std::span<const uint8_t> payload, double now_s,
-             std::vector<std::vector<uint8_t>>& out);
+  bool split(std::string_view channel, std::span<const uint8_t> payload, double now_s, const DatagramSink& sink);
 
   std::optional<seal::Sealer> sealer_;
   seal::Direction direction_;
   ReassemblyLimits limits_;
   uint32_t next_message_ = 1;
-  std::vector<uint8_t> frame_;
+  std::vector<uint8_t> frame_, datagram_;
   ChannelMatcher operator_channels_{""};
   std::optional<seal::CommandSigner> signer_;
   std::optional<seal::Session> session_;

@@ -264,11 +264,12 @@ void DoorHalf::send_due(int64_t now_us) {
   if (const auto& session = receiver_.peer_session()) sender_.set_session(*session);
   else if (options_.half == Half::kGround) send_hello();  // ask for it
   for (auto& p : relay_.due(now_us)) {
-    if (!sender_.send(p.channel, p.data, t, datagrams_)) continue;  // too large: counted
-    for (const auto& d : datagrams_) {
+    // Each datagram leaves as soon as it is sealed (the far half opens it while this one seals the next).
+    const bool sent = sender_.send(p.channel, p.data, t, [this](std::span<const uint8_t> d) {
       if (::sendto(socket_.fd(), d.data(), d.size(), 0, reinterpret_cast<const sockaddr*>(&peer_), sizeof(peer_)) < 0)
         ++send_errors_;
-    }
+    });
+    if (!sent) continue;  // too large, or a command that cannot be signed: counted
     delays_ms_.push_back(static_cast<double>(util::wall_utime() - p.recv_wall_utime) / 1000.0);
   }
 }
