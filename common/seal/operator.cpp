@@ -84,11 +84,13 @@ OperatorKey OperatorKey::clone() const { return OperatorKey(seed_.clone()); }
 
 OperatorKey OperatorKey::generate() { return OperatorKey(SecretKey::generate()); }
 
+OperatorKey OperatorKey::from_seed(SecretKey seed) { return OperatorKey(std::move(seed)); }
+
 OperatorKey OperatorKey::load(const std::string& path) {
   std::vector<uint8_t> bytes = util::read_key_file(path, SecretKey::kSize, "operator key");
   SecretKey seed = SecretKey::from_bytes(bytes);
   sodium_memzero(bytes.data(), bytes.size());
-  return OperatorKey(std::move(seed));
+  return from_seed(std::move(seed));
 }
 
 void OperatorKey::save(const std::string& path, bool overwrite) const {

@@ -54,6 +54,7 @@ struct OperatorPublicKey {
 class OperatorKey {
  public:
   static OperatorKey generate();
+  static OperatorKey from_seed(SecretKey seed);  // a key of known bytes (tests, fuzzing)
   static OperatorKey load(const std::string& path);
   void save(const std::string& path, bool overwrite = false) const;
   const OperatorPublicKey& public_key() const { return public_; }

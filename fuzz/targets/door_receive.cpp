@@ -1,7 +1,7 @@
 // The sealed door's receive path (tools/link/door.hpp: DoorReceiver::receive; issue 46 §4), with
 // the fixed test key of seal_open (bytes 0, 1, ..., 31). One receiver per input, direction
 // air->ground, policy kPolicy (CAM_DOWN rate-limited), limits() (small pending caps, so
-// eviction and timeouts are reached). The first input byte picks what the rest is, modulo 3:
+// eviction and timeouts are reached). The first input byte picks what the rest is, modulo 4:
 //   0  datagrams as they come off the radio, to a secure receiver: records [length u16 LE][bytes]
 //      (a short tail is one datagram), the clock +10 ms each; the seeds hold datagrams sealed by
 //      a DoorSender with the test key, so mutations of authentic ones are tried too;
@@ -26,7 +26,13 @@
 //                 and the completing fragment's bytes at its offset;
 //      2 time:    [u8]: the clock advances that many 50 ms (odd: expire() too);
 //      3 replay:  [which u8][flip position u16][xor u8]: an earlier datagram of this input again.
-// In this mode a datagram opens only if one of the input's senders sealed it, and only once.
+//   3  the operator's commands: records as in 0, to a secure receiver of the other direction
+//      (ground->air) whose operator's channels (kCommands) need the fixed test operator key's
+//      signature for the fixed test session (common/seal/operator.hpp); the seeds hold signed
+//      commands sealed with the test key, so mutations of valid envelopes are tried. A delivery
+//      on an operator's channel must have verified exactly one signature; a refused one is
+//      counted under one command refusal.
+// In mode 2 a datagram opens only if one of the input's senders sealed it, and only once.
 // Checked on every datagram: receive() never throws; counted exactly once (datagrams +1; at most
 // one of delivered / not_allowed / rate_limited / malformed / insecure_peer / secure_peer /
 // too_large / hellos / a command refusal / opener refusal, and none only for a fragment kept or dropped with its message; secure: opened
@@ -54,6 +60,7 @@
 #include <string>
 #include <vector>
 
+#include "common/seal/operator.hpp"
 #include "common/seal/seal.hpp"
 #include "tools/link/door.hpp"
 
@@ -71,6 +78,21 @@ const seal::SecretKey& test_key() {
 }
 
 constexpr seal::Direction kDir = seal::Direction::AirToGround;
+const char* const kCommands = "TRACK|FUZZ";  // mode 3: the operator's channels (inside kPolicy)
+
+const seal::OperatorKey& test_operator() {
+  static const seal::OperatorKey key = [] {
+    std::vector<uint8_t> b(seal::SecretKey::kSize);
+    for (size_t i = 0; i < b.size(); ++i) b[i] = static_cast<uint8_t>(32 + i);
+    return seal::OperatorKey::from_seed(seal::SecretKey::from_bytes(b));
+  }();
+  return key;
+}
+seal::Session test_session() {
+  seal::Session s;
+  for (size_t i = 0; i < s.size(); ++i) s[i] = static_cast<uint8_t>(0xC0 + i);
+  return s;
+}
 const char* const kPolicy = "VO_POSE|TRACK|CAM_DOWN|FUZZ";
 const char* const kLimited = "CAM_DOWN";
 const char* const kChannels[] = {"VO_POSE", "TRACK", "CAM_DOWN", "FUZZ", "PILOT_CMD", "MAP_CMD", "X"};
@@ -175,7 +197,7 @@ Outcome feed(link::DoorReceiver& rx, std::span<const uint8_t> d, double now_s) {
     if (rx.secure() && !out.opened) fail("delivered without opening a datagram", rx);
   } else {
     if (after.delivered != before.delivered) fail("delivery counted, nothing returned", rx);
-    if (own == 1 && rx.why().empty()) fail("a refusal without why()", rx);
+    if (own == 1 && rx.why().empty() && after.hellos == before.hellos) fail("a refusal without why()", rx);
   }
   return out;
 }
@@ -232,6 +254,32 @@ void raw(std::span<const uint8_t> in, bool secure) {
     now += 0.01;
   }
   finish(rx, now);
+}
+
+// Mode 3: the operator's commands through a ground->air receiver.
+void commands(std::span<const uint8_t> in) {
+  link::DoorPolicy p = policy();
+  p.operator_channels = kCommands;
+  link::DoorReceiver rx(&test_key(), seal::Direction::GroundToAir, p, {}, limits());
+  rx.require_operator(seal::CommandVerifier({test_operator().public_key()}, test_session()));
+  static const std::regex operator_channel(kCommands);
+  Reader r{in};
+  double now = 0;
+  for (size_t step = 0; step < kMaxSteps && !r.done(); ++step) {
+    const size_t n = r.in.size() - r.pos < 2 ? 2 : r.u16();
+    const link::ReceiverCounters before = rx.counters();
+    const Outcome o = feed(rx, r.bytes(n), now);
+    const link::ReceiverCounters& after = rx.counters();
+    uint64_t refused = 0;
+    for (size_t i = 0; i < seal::kCommandRefusalCount; ++i) refused += after.commands_refused[i] - before.commands_refused[i];
+    const uint64_t verified = after.commands_verified - before.commands_verified;
+    if (refused + verified > 1) fail("one command counted twice", rx);
+    if (o.delivered && std::regex_match(o.delivered->channel, operator_channel) && verified != 1)
+      fail("an operator's command delivered without a verified signature", rx);
+    if (o.delivered && !std::regex_match(o.delivered->channel, operator_channel) && verified != 0)
+      fail("a signature verified for a channel that is not the operator's", rx);
+    now += 0.01;
+  }
 }
 
 void flip(std::vector<uint8_t>& d, uint16_t position, uint8_t x) {
@@ -466,6 +514,24 @@ void write_seeds(const std::string& dir) {
   for (uint8_t id = 11; id <= 16; ++id) op_frame(v, id % 3, "TRACK", 1, id, 1, 2, 16, 8, 8);
   write("ops_evict", v);
   v = {2}, op_send(v, "PILOT_CMD", 900), op_send(v, "MAP_CMD", 10), write("ops_not_allowed", v);
+  // Mode 3: signed commands (one whole, one fragmented), a bare one, one of another session.
+  const auto command_records = [&](std::vector<uint8_t>& v, const std::string& channel, size_t size,
+                                   const seal::Session& session) {
+    link::DoorSender tx(&test_key(), seal::Direction::GroundToAir, 1, 0, 0, {}, limits());
+    tx.sign_commands(kCommands, seal::CommandSigner(test_operator().clone()));
+    tx.set_session(session);
+    std::vector<uint8_t> payload(size);
+    for (size_t i = 0; i < size; ++i) payload[i] = static_cast<uint8_t>(i * 11);
+    std::vector<std::vector<uint8_t>> ds;
+    tx.send(channel, payload, 0, ds);
+    for (const auto& d : ds) {
+      put16(v, static_cast<uint16_t>(d.size()));
+      v.insert(v.end(), d.begin(), d.end());
+    }
+  };
+  v = {3}, command_records(v, "TRACK", 40, test_session()), command_records(v, "FUZZ", 1000, test_session());
+  command_records(v, "VO_POSE", 20, test_session()), write("commands_signed", v);
+  v = {3}, command_records(v, "TRACK", 40, seal::new_session()), write("commands_other_session", v);
 }
 
 }  // namespace
@@ -481,10 +547,11 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   const std::span<const uint8_t> rest(data + 1, size - 1);
-  switch (data[0] % 3) {
+  switch (data[0] % 4) {
     case 0: raw(rest, true); break;
     case 1: raw(rest, false); break;
-    default: ops(rest); break;
+    case 2: ops(rest); break;
+    default: commands(rest); break;
   }
   return 0;
 }
