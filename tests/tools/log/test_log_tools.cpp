@@ -1,7 +1,7 @@
 // aerie-log's library: info (types by fingerprint, counts, rates, logger losses told apart
 // from producer skips, corrupt payloads, damage), export (TUM trajectories, PNG images, a
 // stereo channel to a KITTI-style folder that the capture source reads back, tracks to OTB
-// boxes), cut, and diff (also through the executable, for its exit status).
+// boxes), cut, and diff (by order, seq or utime; also through the executable, for its exit status).
 #include <gtest/gtest.h>
 
 #include <aerie/gt_pose_t.hpp>
@@ -21,6 +21,7 @@
 
 #include "air/capture/dataset_io.hpp"
 #include "air/capture/stereo_sequence_source.hpp"
+#include "air/track/eval/box_file_score.hpp"
 #include "air/track/eval/sequence.hpp"
 #include "common/bus/wire.hpp"
 #include "common/image/image_message.hpp"
@@ -507,6 +508,80 @@ TEST(LogExport, TrackToOtbBoxes) {
   EXPECT_EQ(boxes[2], cv::Rect2d(82.5, 50, 40, 20));  // centre (102.5, 60), 40 x 20
 }
 
+// The tracker skipped frames 3 and 7 of its camera: the OTB file still has one row per source
+// frame, NaN where no track exists, so row i lines up with frame i of groundtruth.txt.
+TEST(LogExport, TrackHasOneRowPerSourceFrame) {
+  const auto dir = test::scratch_dir("log");
+  const auto path = (dir / "track.lcm").string();
+  const int64_t t0 = 1'700'000'000'000'000;
+  {
+    logio::Writer w(path);
+    for (int i = 0; i < 10; ++i) {
+      const int64_t t = t0 + 50'000 * i;
+      const auto img = encode(image::to_message(texture(i), t, 100 + i));
+      w.write(t, "CAM_MONO", img.data(), img.size());
+      if (i == 3 || i == 7) continue;
+      auto tr = track(t, i, aerie::track_t::TRACKING, 100.5 + i, 60);
+      tr.camera = "CAM_MONO";
+      const auto b = encode(tr);
+      w.write(t + 20'000, "TRACK", b.data(), b.size());
+    }
+  }
+  const auto r = export_channel(path, "TRACK", (dir / "out").string());
+  EXPECT_EQ(r.exported, 8);
+  EXPECT_EQ(r.camera, "CAM_MONO");
+  EXPECT_EQ(r.frames, 10);
+  EXPECT_EQ(r.skipped_frames, 2);
+  EXPECT_TRUE(r.notes.empty());
+  const auto boxes = track::eval::read_boxes(dir / "out/TRACK.txt");
+  ASSERT_EQ(boxes.size(), 10u);  // the source's frame count
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_EQ(track::eval::is_valid_box(boxes[i]), i != 3 && i != 7) << i;
+    if (i != 3 && i != 7) {
+      EXPECT_EQ(boxes[i], cv::Rect2d(80.5 + i, 50, 40, 20)) << i;  // frame i's own box
+    }
+  }
+  std::ifstream csv(dir / "out/TRACK.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(csv, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 11u);
+  EXPECT_EQ(rows[4], "1700000000.150000,103,NaN,NaN,NaN,NaN,SKIPPED,NaN");  // the frame's own seq
+  EXPECT_EQ(rows[5], "1700000000.200000,4,84.500,50.000,40.000,20.000,TRACKING,0.750");
+  // Scored against the sequence's ground truth (the true box of every frame), frame by frame:
+  // the 8 tracked frames are exact, the 2 skipped ones failures.
+  std::vector<cv::Rect2d> gt;
+  for (int i = 0; i < 10; ++i) gt.emplace_back(80.5 + i, 50, 40, 20);
+  track::eval::write_boxes(dir / "groundtruth.txt", gt);
+  const auto scored = track::eval::score_box_file(dir / "out/TRACK.txt", dir / "groundtruth.txt");
+  EXPECT_EQ(scored.missing, 2);
+  EXPECT_NEAR(scored.score.auc, 0.8 * 20.0 / 21.0, 1e-12);
+  EXPECT_NEAR(scored.score.precision20, 0.8, 1e-12);
+
+  // Tracks that name another camera than the one in the log: one row per message, and a note;
+  // --camera names the source.
+  {
+    logio::Writer w((dir / "other.lcm").string());
+    for (const auto& ev : logio::read_all(path).events) {
+      auto out = ev;
+      if (ev.channel == "TRACK") {
+        auto m = bus::decode_bounded<aerie::track_t>(ev.data.data(), ev.data.size());
+        m.camera = "CAM_LEFT";
+        out.data = encode(m);
+      }
+      w.write(out);
+    }
+  }
+  const auto plain = export_channel((dir / "other.lcm").string(), "TRACK", (dir / "plain").string());
+  EXPECT_EQ(plain.frames, 0);
+  EXPECT_EQ(track::eval::read_boxes(dir / "plain/TRACK.txt").size(), 8u);
+  ASSERT_EQ(plain.notes.size(), 1u);
+  EXPECT_NE(plain.notes[0].find("no frames of CAM_LEFT in the log"), std::string::npos) << plain.notes[0];
+  const auto named =
+      export_channel((dir / "other.lcm").string(), "TRACK", (dir / "named").string(), false, false, "CAM_MONO");
+  EXPECT_EQ(named.frames, 10);
+  EXPECT_EQ(track::eval::read_boxes(dir / "named/TRACK.txt").size(), 10u);
+}
+
 TEST(MessageFields, NamesTheFieldOfTheLargestDifference) {
   auto a = track(1000, 3, aerie::track_t::TRACKING, 100, 50);
   a.levels = {level(2), level(3)};
@@ -733,6 +808,103 @@ TEST(LogDiff, ExitStatusOfTheCommand) {
   const auto help = aerie_log("diff --help", run_dir);
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("paired by their order within the channel"), std::string::npos) << help.out;
+}
+
+// A live run against its replay: B misses frame 2 (a frame the live chain skipped) on every
+// keyed channel. Pairing by position shifts every pair after it; by seq or utime exactly one
+// frame is missing in B and the rest are identical.
+fs::path make_frames_log(const fs::path& path, int skip) {
+  logio::Writer w(path.string());
+  const int64_t t0 = 1'700'000'000'000'000;
+  for (int i = 0; i < 20; ++i) {
+    const int64_t t = t0 + 50'000 * i;
+    if (i != skip) {
+      const auto img = encode(image::to_message(texture(i), t, i));
+      w.write(t + 100, "CAM_LEFT", img.data(), img.size());
+      const auto tr = encode(track(t, i, aerie::track_t::TRACKING, 100.0 + i, 60));
+      w.write(t + 200, "TRACK", tr.data(), tr.size());
+      const auto gt = encode(pose(t, i));
+      w.write(t + 300, "GT_POSE", gt.data(), gt.size());
+    }
+    if (i % 5 == 0) {
+      const std::string junk = "no fingerprint, no key " + std::to_string(i);
+      w.write(t + 400, "RAW", junk.data(), junk.size());
+    }
+  }
+  return path;
+}
+
+TEST(LogDiff, PairsBySeqOrUtimeAfterASkippedFrame) {
+  const auto dir = test::scratch_dir("log");
+  const auto a = make_frames_log(dir / "live.lcm", -1).string(), b = make_frames_log(dir / "replay.lcm", 2).string();
+
+  const auto by_order = diff_logs(a, b);
+  for (const char* name : {"CAM_LEFT", "TRACK", "GT_POSE"}) {
+    const auto& c = channel(by_order, name);
+    EXPECT_EQ(c.paired_by, PairBy::Order);
+    EXPECT_EQ(c.count_a, 20);
+    EXPECT_EQ(c.count_b, 19);
+    EXPECT_EQ(c.matched, 19);
+    EXPECT_EQ(c.identical, 2) << name;  // frames 0 and 1; then frame i of A against frame i + 1 of B
+    EXPECT_EQ(c.differing(), 17) << name;
+    EXPECT_EQ(c.missing_b, 1);
+  }
+
+  for (const PairBy by : {PairBy::Utime, PairBy::Seq}) {
+    const auto d = diff_logs(a, b, {}, by);
+    EXPECT_EQ(d.pair_by, by);
+    EXPECT_FALSE(d.same());
+    for (const char* name : {"CAM_LEFT", "TRACK", "GT_POSE"}) {
+      const auto& c = channel(d, name);
+      EXPECT_EQ(c.paired_by, by) << name;
+      EXPECT_EQ(c.matched, 19) << name;
+      EXPECT_EQ(c.identical, 19) << name;
+      EXPECT_EQ(c.differing(), 0) << name;
+      EXPECT_EQ(c.missing_a, 0) << name;
+      EXPECT_EQ(c.missing_b, 1) << name;
+      EXPECT_TRUE(c.field.empty()) << name;
+      EXPECT_FALSE(c.same());
+    }
+    // RAW has no type, so no key: paired by order, and identical.
+    EXPECT_EQ(channel(d, "RAW").paired_by, PairBy::Order);
+    EXPECT_TRUE(channel(d, "RAW").same());
+    std::ostringstream out;
+    print_diff(d, out);
+    const std::string row = std::string(to_string(by)) + (by == PairBy::Seq ? "   " : " ") +
+                            "       20       19       19         0         1        19         0  -\n";
+    EXPECT_NE(out.str().find("TRACK              aerie.track_t            " + row), std::string::npos) << out.str();
+    EXPECT_NE(out.str().find("different: 3 of 4 channel(s): CAM_LEFT, GT_POSE, TRACK"), std::string::npos)
+        << out.str();
+  }
+
+  // A changed field is shown at its frame, not at a message index.
+  const auto events = logio::read_all(b).events;
+  {
+    logio::Writer w((dir / "changed.lcm").string());
+    for (auto ev : events) {
+      if (ev.channel == "TRACK") {
+        auto m = bus::decode_bounded<aerie::track_t>(ev.data.data(), ev.data.size());
+        if (m.seq == 9) m.x += 2.5;
+        ev.data = encode(m);
+      }
+      w.write(ev);
+    }
+  }
+  const auto& tr = channel(diff_logs(a, (dir / "changed.lcm").string(), {"TRACK"}, PairBy::Seq), "TRACK");
+  EXPECT_EQ(tr.identical, 18);
+  EXPECT_EQ(tr.differing(), 1);
+  EXPECT_EQ(tr.field, "x");
+  EXPECT_EQ(tr.at_what, "seq");
+  EXPECT_EQ(tr.at, 9);
+
+  // Through the command: the option, its exit status, its refusal.
+  const auto run_dir = test::scratch_dir("run");
+  const auto run = aerie_log("diff " + a + " " + b + " --pair utime", run_dir);
+  EXPECT_EQ(run.status, 1);
+  EXPECT_NE(run.out.find("missing B"), std::string::npos) << run.out;
+  EXPECT_EQ(aerie_log("diff " + a + " " + a + " --pair seq", run_dir).status, 0);
+  EXPECT_EQ(aerie_log("diff " + a + " " + b + " --pair frame", run_dir).status, 2);
+  EXPECT_THROW(pair_by_from_string("frame"), std::invalid_argument);
 }
 
 TEST(LogInfo, HostileSequenceNumbersSaturateInsteadOfOverflowing) {
