@@ -57,7 +57,8 @@ class ControlLoop {
   ControlLoop(flc::FlcSpec controller, ControlConfig config);
 
   // A heading measurement: utime of its source frame (message time, drives the FLC's
-  // derivative and integral) and the wall-clock time it was received (for staleness).
+  // derivative and integral) and the node-clock time it was received (for staleness: the wall
+  // clock live, the simulation's in lock-step, the input clock in a replay).
   // Returns false (and ignores it) if it is not newer than the last one or not finite.
   // `position` (any fixed frame, m) is the pose's; activation_distance_m measures it.
   // `age_s` is the heading's age on arrival (util::message_age_s; nullopt when the clocks

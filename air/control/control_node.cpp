@@ -129,11 +129,14 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
       opt_(checked(std::move(options))),
       loop_(std::move(controller), opt_.control),
       now_(std::move(now)),
-      pose_clock_(status, opt_.pose_channel, opt_.message_time) {
+      pose_clock_(status, opt_.pose_channel, opt_.message_time),
+      input_clock_(opt_.pose_channel + " (input clock)", opt_.message_time) {
+  if (opt_.message_clock) now_ = [this] { return input_now_; };
   period_us_ = opt_.rate_hz > 0 ? static_cast<int64_t>(1e6 / opt_.rate_hz) : 0;
   switch (opt_.input) {
     case NodeOptions::Input::kVoPose:
       bus_.subscribe<aerie::pose_t>(opt_.pose_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
+        on_input_time(m.utime);
         if (m.status == aerie::pose_t::OK) {
           source_was_ok_ = true;
           on_pose(m.utime, m.orientation, m.position);
@@ -147,6 +150,7 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
       break;
     case NodeOptions::Input::kNavState:
       bus_.subscribe<aerie::nav_state_t>(opt_.pose_channel, [this](const aerie::nav_state_t& m, const bus::ReceiveInfo&) {
+        on_input_time(m.utime);
         // IMU_ONLY is the filter bridging a VO outage within its configured time: still flown on.
         // A restarted aerie-nav initialises for its whole alignment window (200 messages at 1 s
         // and 200 Hz); one message saying so is a corrupt one, not a restart.
@@ -164,6 +168,7 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
       break;
     case NodeOptions::Input::kGtPose:
       bus_.subscribe<aerie::gt_pose_t>(opt_.pose_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
+        on_input_time(m.utime);
         on_pose(m.utime, m.orientation, m.position);
         answer();
       });
@@ -172,6 +177,12 @@ ControlNode::ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpe
   bus_.subscribe<aerie::flc_params_t>(opt_.params_channel,
                                       [this](const aerie::flc_params_t& m, const bus::ReceiveInfo&) { on_params(m); });
   status_.ok("controller " + loop_.controller().id);
+}
+
+void ControlNode::on_input_time(int64_t utime) {
+  if (!opt_.message_clock) return;
+  // The pose clock counts and reports jumps; this one only keeps them from moving the time.
+  if (input_clock_.observe(utime, input_now_).accepted()) input_now_ = input_clock_.newest();
 }
 
 void ControlNode::answer() {
@@ -235,7 +246,7 @@ void ControlNode::on_heading(int64_t utime, double heading_deg, const Eigen::Vec
       spdlog::warn("pose on {} is {:.0f} ms old (limit {:.0f} ms): hovering until a fresh one ({} so far)",
                    opt_.pose_channel, *age_s * 1e3, loop_.config().max_input_age_s * 1e3, aged_poses_);
   }
-  last_receive_ = receive_us;
+  last_receive_ = opt_.message_clock ? util::wall_utime() : receive_us;  // for the status' latency hop
 }
 
 void ControlNode::on_params(const aerie::flc_params_t& m) {

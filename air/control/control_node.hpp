@@ -35,6 +35,10 @@ struct NodeOptions {
   std::string anchor_file;
   // message_time.max_jump_s / resync_messages; its stale timeout is control.stale_timeout_s.
   util::MessageClockConfig message_time;
+  // true (aerie-control --replay): the node's clock is the input clock, the newest message time
+  // seen on the pose channel (any status; a jump is held as on the pose clock), so the age and
+  // staleness rules judge a replayed log on its own time, not on the wall clock (docs/control.md).
+  bool message_clock = false;
 };
 
 // VO_POSE, NAV_STATE or GT_POSE.
@@ -65,10 +69,14 @@ flc::FlcSpec controller_from_message(const aerie::flc_params_t& m, const flc::Fl
 
 class ControlNode {
  public:
-  // `now` is the node's clock: the receive time of a pose for staleness (wall clock live;
-  // tests and lock-step drivers pass theirs, the same one they give tick()).
+  // `now` is the node's clock: the receive time of a pose for its age and staleness (wall clock
+  // live; tests and lock-step drivers pass theirs, the same one they give tick()). With
+  // options.message_clock it is not used: the input clock replaces it.
   ControlNode(bus::Bus& bus, bus::StatusReporter& status, flc::FlcSpec controller, NodeOptions options,
               util::NodeClock now = util::wall_utime);
+
+  // The node's clock now (the one to give tick()).
+  int64_t now() const { return now_(); }
 
   // Publishes a command when a period of the rate has elapsed since the last one (nothing
   // when rate_hz is 0: commands then follow the input).
@@ -80,6 +88,8 @@ class ControlNode {
   void on_pose(int64_t utime, const double orientation[4], const double position[3]);
   void on_heading(int64_t utime, double heading_deg, const Eigen::Vector3d& position, int64_t receive_us);
   void answer();  // rate_hz 0: the command that follows an input message
+  // Every message on the pose channel moves the input clock (options.message_clock).
+  void on_input_time(int64_t utime);
   void on_params(const aerie::flc_params_t& m);
   // The manoeuvre is defined from its start pose in the estimator's frame. It is refused for
   // good — FALLBACK_HOVER, health ERROR, until the mission is restarted — when that frame is
@@ -99,6 +109,8 @@ class ControlNode {
   int64_t seq_ = 0, next_publish_ = 0, period_us_ = 0, last_receive_ = 0;
   util::NodeClock now_;
   bus::InputClock pose_clock_;  // the message-time policy of the pose source
+  util::MessageClock input_clock_;  // options.message_clock: the newest message time seen
+  int64_t input_now_ = 0;
   int64_t bad_poses_ = 0, aged_poses_ = 0;
   bool source_was_ok_ = false, had_pose_ = false;
   static constexpr int kNavRestartMessages = 3;  // INITIALISING in a row after OK: a restart

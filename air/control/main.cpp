@@ -12,7 +12,6 @@
 #include "common/bus/node.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/util/cli.hpp"
-#include "common/util/time.hpp"
 
 using namespace aerie;
 
@@ -30,23 +29,28 @@ int main(int argc, char** argv) {
   app.add_option("--speed", cli.forward_speed, "forward speed commanded while active (m/s)");
   app.add_option("--rate", cli.rate_hz, "CTRL_CMD rate (Hz); 0 = one command per input message");
   app.add_option("--stale-timeout", cli.stale_timeout_s, "hover when no heading for this long (s)");
+  bool replay = false;
+  app.add_flag("--replay", replay,
+               "replaying a log: judge the poses' age and staleness on the log's time (the newest message time "
+               "seen) instead of the wall clock");
   CLI11_PARSE(app, argc, argv);
   util::init_logging("control", common.log_level);
   try {
     const util::Config cfg = common.config.empty() ? util::Config() : util::Config::load(common.config);
-    const control::NodeSetup setup = control::node_setup(cfg, cli);
+    control::NodeSetup setup = control::node_setup(cfg, cli);
+    setup.options.message_clock = replay;
     bus::require_host_local_commands("aerie-control", "FLC_PARAMS", common.lcm_url);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "control");
     control::ControlNode node(bus, status, setup.controller, setup.options);
-    spdlog::info("controller '{}' ({} rules), input {} on {}, CTRL_CMD at {} Hz, reference {} deg{}, stale after {} s",
+    spdlog::info("controller '{}' ({} rules), input {} on {}, CTRL_CMD at {} Hz, reference {} deg{}, stale after {} s{}",
                  setup.controller.id, setup.controller.rules.size(),
                  cli.input.empty() ? cfg.get<std::string>("input", "vo") : cli.input,
                  setup.options.pose_channel, setup.options.rate_hz,
                  setup.options.control.reference_deg, setup.options.control.reference_relative ? " (relative)" : "",
-                 setup.options.control.stale_timeout_s);
+                 setup.options.control.stale_timeout_s, replay ? " (replay: on the log's time)" : "");
     bus::run(bus, status, [&] {
-      node.tick(util::wall_utime());
+      node.tick(node.now());
       return true;
     }, 2);
     spdlog::info("stopped");

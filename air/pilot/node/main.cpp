@@ -23,6 +23,10 @@ int main(int argc, char** argv) {
   app.add_option("--controller", controller, "landing controller: fuzzy or pid (overrides the config)")
       ->check(CLI::IsMember({"fuzzy", "pid"}));
   app.add_flag("--wait-for-start", wait_for_start, "stay IDLE until an operator START on PILOT_CMD");
+  pilot::PilotNodeOptions options;
+  app.add_flag("--replay", options.message_clock,
+               "replaying a log: judge the inputs' age on the log's time (the newest message time seen) instead "
+               "of the wall clock");
   CLI11_PARSE(app, argc, argv);
   util::init_logging("pilot", common.log_level);
   try {
@@ -39,7 +43,7 @@ int main(int argc, char** argv) {
     bus::require_host_local_commands("aerie-pilot", "PILOT_CMD", common.lcm_url);
     bus::Bus bus(common.lcm_url);
     bus::StatusReporter status(bus, "pilot");
-    pilot::PilotNode node(bus, pc);
+    pilot::PilotNode node(bus, pc, options);
     spdlog::info("{} controller, approach at {} m, descent at {} m/s, touchdown below {} m{}", pc.controller,
                  pc.approach_height_m, pc.descent_speed_m_s, pc.touchdown_height_m,
                  pc.wait_for_start ? "; waiting for START on PILOT_CMD" : "");

@@ -20,6 +20,8 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
       now_(std::move(now)),
       track_time_("tracker", pilot_.config().message_time),
       imu_time_(opt_.imu_channel, pilot_.config().message_time) {
+  if (opt_.message_clock)
+    now_ = [this] { return input_time(0); };
   // Every handler turns a refused input into a counted error; the pilot keeps its state.
   auto guarded = [this](const std::string& what, auto&& fn) {
     try {
@@ -92,7 +94,7 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
       return;
     }
     // On the pilot's own time: the operator's stamp (another host's clock) never moves its clock.
-    const int64_t utime = imu_time_.synced() ? imu_time_.newest() : track_time_.synced() ? track_time_.newest() : m.utime;
+    const int64_t utime = input_time(m.utime);
     std::string why;
     if (pilot_.on_operator(static_cast<Pilot::Operator>(m.command), utime, &why)) {
       count("operator_accepted");
@@ -115,7 +117,15 @@ bool PilotNode::on_time(util::MessageClock& clock, const std::string& channel, i
   return false;
 }
 
-std::optional<double> PilotNode::input_age(int64_t utime) { return last_age_s_ = util::message_age_s(utime, now_()); }
+int64_t PilotNode::input_time(int64_t otherwise) const {
+  return imu_time_.synced() ? imu_time_.newest() : track_time_.synced() ? track_time_.newest() : otherwise;
+}
+
+std::optional<double> PilotNode::input_age(int64_t utime) {
+  // Replayed, a result is late only behind a newer one of its own source: how far the replayed
+  // tracker lags the log's IMU depends on the replaying machine, not on the flight.
+  return last_age_s_ = util::message_age_s(utime, opt_.message_clock ? track_time_.newest() : now_());
+}
 
 void PilotNode::publish(const Command& c) {
   const PilotStatus& s = pilot_.status();

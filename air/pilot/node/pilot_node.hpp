@@ -28,11 +28,16 @@ struct PilotNodeOptions {
   std::string command_channel = "CTRL_CMD";
   std::string state_channel = "PILOT_STATE";
   std::string autopilot_channel = "AUTOPILOT_STATE";  // aerie-mavlink's view of the autopilot's link
+  // true (aerie-pilot --replay): the node's clock is the input clock, the newest message time
+  // seen (IMU, else the tracker's), and a TRACK's age is taken against the newest tracker time
+  // seen, so a replayed log is judged on its own time, not on the wall clock (docs/logs.md, replay).
+  bool message_clock = false;
 };
 
 class PilotNode {
  public:
-  // `now` is the node's clock for the message-time policy (wall clock live; tests pass theirs).
+  // `now` is the node's clock for the message-time policy and the age rule (wall clock live;
+  // tests pass theirs); with options.message_clock the input clock replaces it.
   PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options = {}, util::NodeClock now = util::wall_utime);
   void report(bus::StatusReporter& status) const;
   const Pilot& pilot() const { return pilot_; }
@@ -45,6 +50,8 @@ class PilotNode {
   bool on_time(util::MessageClock& clock, const std::string& channel, int64_t utime);
   // A frame's age on the node's clock (PilotConfig::max_input_age_s; util::message_age_s).
   std::optional<double> input_age(int64_t utime);
+  // The pilot's own time: the newest IMU time, else the newest tracker time, else `otherwise`.
+  int64_t input_time(int64_t otherwise) const;
 
   bus::Bus& bus_;
   Pilot pilot_;

@@ -4,9 +4,12 @@
 
 #include <Eigen/Geometry>
 #include <aerie/process_status_t.hpp>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <optional>
+#include <vector>
 
 #include "air/control/anchor_file.hpp"
 #include "air/control/control_config.hpp"
@@ -777,4 +780,79 @@ TEST(ControlNode, TheShippedControllersPassTheIncomingChecks) {
     EXPECT_NO_THROW(controller_from_message(m, tuned())) << file;
   }
   EXPECT_NO_THROW(check_incoming_controller(flc::thesis_initial(), "initial"));
+}
+
+namespace {
+
+// 2 s of VO_POSE at 30 Hz turning from 0 to 20 deg, 1 s LOST, 1 s OK again at 20 deg: stamped from t0.
+std::vector<aerie::pose_t> turn_lost_and_back(int64_t t0) {
+  std::vector<aerie::pose_t> poses;
+  for (int k = 0; k < 120; ++k) {
+    aerie::pose_t p = vo_pose(t0 + k * 33'333, k < 60 ? k / 3.0 : 20.0);
+    if (k >= 60 && k < 90) p.status = aerie::pose_t::LOST;
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+// The CTRL_CMD answering each pose (rate 0), on the node clock `clock`; `before` runs before each pose.
+std::vector<aerie::control_cmd_t> answers(const std::vector<aerie::pose_t>& poses, bool message_clock,
+                                          util::NodeClock clock, const std::function<void(const aerie::pose_t&)>& before = {}) {
+  bus::Bus bus("memq://");
+  bus::StatusReporter status(bus, "control");
+  NodeOptions opt;
+  opt.rate_hz = 0;
+  opt.message_clock = message_clock;
+  ControlNode node(bus, status, tuned(), opt, std::move(clock));
+  std::vector<aerie::control_cmd_t> cmds;
+  bus.subscribe<aerie::control_cmd_t>("CTRL_CMD", [&](const aerie::control_cmd_t& m, const bus::ReceiveInfo&) { cmds.push_back(m); });
+  for (const auto& p : poses) {
+    if (before) before(p);
+    bus.publish("VO_POSE", p);
+    drain(bus);
+  }
+  return cmds;
+}
+
+std::vector<uint8_t> encoded(const aerie::control_cmd_t& m) {
+  std::vector<uint8_t> b(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(b.data(), 0, static_cast<int>(b.size()));
+  return b;
+}
+
+int count_mode(const std::vector<aerie::control_cmd_t>& cmds, int8_t mode) {
+  return static_cast<int>(std::count_if(cmds.begin(), cmds.end(), [&](const auto& c) { return c.mode == mode; }));
+}
+
+}  // namespace
+
+TEST(ControlNode, AReplayOnTheLogsTimeGivesTheLiveCommandsNotAHover) {
+  // Issue 49: replayed 7.5 s after it was recorded, every pose was judged 7478 ms old on the wall
+  // clock and every CTRL_CMD was a hover. A flight recorded 7.478 s and 3 days ago: live, each pose
+  // arrived 20 ms after its frame; replayed as aerie-control --replay does (the wall clock is the
+  // node's clock but the log's own time is used), the commands are the live ones byte for byte.
+  for (const int64_t ago : {int64_t{7'478'000}, int64_t{3} * 86'400'000'000}) {
+    const auto poses = turn_lost_and_back(util::wall_utime() - ago);
+    int64_t now = 0;
+    const auto live = answers(poses, false, [&] { return now; }, [&](const aerie::pose_t& p) { now = p.utime + 20'000; });
+    ASSERT_EQ(live.size(), 120u);
+    // Flown on every fresh pose; LOST for longer than stale_timeout_s (0.5 s): from the 16th LOST
+    // pose on FALLBACK_HOVER, until the first OK one.
+    EXPECT_EQ(count_mode(live, aerie::control_cmd_t::ACTIVE), 105);
+    EXPECT_EQ(count_mode(live, aerie::control_cmd_t::FALLBACK_HOVER), 15);
+    EXPECT_EQ(live[89].mode, aerie::control_cmd_t::FALLBACK_HOVER);
+    EXPECT_EQ(live[90].mode, aerie::control_cmd_t::ACTIVE);
+    EXPECT_GT(std::abs(live[30].yaw_rate_deg_s), 1.0f);
+    const auto replayed = answers(poses, true, util::wall_utime);
+    ASSERT_EQ(replayed.size(), live.size()) << ago;
+    for (size_t i = 0; i < live.size(); ++i)
+      ASSERT_EQ(encoded(replayed[i]), encoded(live[i])) << "command " << i << ", replayed " << ago << " us later";
+  }
+  // On the wall clock, what a replay used to do: 7.478 s old is past max_input_age_s, every pose hovers.
+  const auto old_rule = answers(turn_lost_and_back(util::wall_utime() - 7'478'000), false, util::wall_utime);
+  EXPECT_EQ(count_mode(old_rule, aerie::control_cmd_t::ACTIVE), 0);
+  // 3 days old, the wall-clock age is not comparable, but a replay faster than real time never
+  // saw the second of LOST poses go stale: no FALLBACK_HOVER where the live flight had 15.
+  const auto burst = answers(turn_lost_and_back(util::wall_utime() - int64_t{3} * 86'400'000'000), false, util::wall_utime);
+  EXPECT_EQ(count_mode(burst, aerie::control_cmd_t::FALLBACK_HOVER), 0);
 }

@@ -147,6 +147,34 @@ TEST(PilotNode, AgesEachTrackOnItsOwnClockWhenTheClocksAreComparable) {
   EXPECT_EQ(cmds.size(), 7u);  // every TRACK answered, aged or not (lock-step)
 }
 
+TEST(PilotNode, ReplayedTracksAreAgedOnTheLogsTimeNotTheWallClock) {
+  // Issue 49: a log replayed 7.5 s after it was recorded; on the wall clock every TRACK is 7.5 s
+  // old (HOLD); aerie-pilot --replay ages it against the newest tracker time seen.
+  const auto config = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
+  for (const bool replay : {false, true}) {
+    bus::Bus bus("memq://");
+    pilot::PilotNodeOptions opt;
+    opt.message_clock = replay;
+    pilot::PilotNode node(bus, config, opt, util::wall_utime);
+    aerie::track_t t{};
+    t.status = aerie::track_t::IDLE;
+    const int64_t t0 = util::wall_utime() - 7'500'000;
+    for (int k = 0; k < 3; ++k) {
+      t.utime = t0 + k * 50'000;
+      bus.publish("TRACK", t);
+      while (bus.handle(0) > 0) {
+      }
+    }
+    EXPECT_EQ(node.pilot().status().aged_results, replay ? 0 : 3) << replay;
+    if (!replay) continue;
+    t.utime = t0 + 100'000 - 500'000;  // 0.5 s behind the newest: late on the log's time too
+    bus.publish("TRACK", t);
+    while (bus.handle(0) > 0) {
+    }
+    EXPECT_EQ(node.pilot().status().aged_results, 1);
+  }
+}
+
 namespace {
 // The default logger's output in a string while it lives.
 struct CapturedLog {
