@@ -1,5 +1,6 @@
 #include "common/sim/flight/flight_config.hpp"
 
+#include "common/sim/camera/camera_effects_config.hpp"
 #include "common/sim/sim_config.hpp"
 #include "common/util/section_reader.hpp"
 
@@ -60,7 +61,8 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
       .known("stereo_rig")
       .known("wind")
       .known("vibration")
-      .known("placement")("stereo", &F::stereo)("frame_rate_hz", &F::frame_rate_hz)("max_time_s", &F::max_time_s)(
+      .known("placement")
+      .known("camera_effects")("stereo", &F::stereo)("frame_rate_hz", &F::frame_rate_hz)("max_time_s", &F::max_time_s)(
           "seed", &F::seed)("start_utime", &F::start_utime)
       .finish();
   f.world = load_world_config(cfg.section("world"));
@@ -68,6 +70,10 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
   f.imu = load_imu(cfg.section("imu"));
   f.down_camera = load_rig_config(cfg.section("down_camera"), FlightSimConfig::down_rig());
   f.stereo_rig = load_rig_config(cfg.section("stereo_rig"));
+  const util::Config effects = cfg.section("camera_effects");
+  effects.check_keys({"down.*", "stereo.*"});
+  f.down_effects = load_camera_effects(effects.section("down"));
+  f.stereo_effects = load_camera_effects(effects.section("stereo"));
   using C = CalibrationError;
   util::SectionReader<C>(cfg.section("calibration_error"), f.calibration_error)("focal_rel", &C::focal_rel)(
       "principal_px", &C::principal_px)

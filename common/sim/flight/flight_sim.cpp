@@ -14,6 +14,49 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 
+camera::CameraModel pinhole_of(const Intrinsics& K) { return K.calibration().left; }
+
+// The real camera a stage models: the lens calibration, or the rig's pinhole with the lens'
+// coefficients, or the rig's pinhole (no lens).
+camera::CameraModel real_camera(const CameraEffectsConfig& fx, const Intrinsics& rig) {
+  if (!fx.lens.enabled) return pinhole_of(rig);
+  if (fx.lens.model.width > 0) return fx.lens.model;
+  camera::CameraModel m = pinhole_of(rig);
+  m.distortion = fx.lens.model.distortion;
+  m.coeffs = fx.lens.model.coeffs;
+  return m;
+}
+
+// A rig whose ideal (pinhole) frames cover every ray of the real camera: the lens' field of
+// view when it is wider; without noise of its own when the stage adds the sensor's.
+RigConfig ideal_rig(RigConfig rig, const CameraEffectsConfig& fx, const camera::CameraModel& real) {
+  if (!fx.any()) return rig;
+  if (fx.noise.enabled) rig.noise_sigma = 0;
+  if (fx.lens.enabled) {
+    const auto [h, v] = CameraEffects::fov_to_cover(real);
+    rig.hfov_deg = std::min(178.0, std::max(rig.hfov_deg, h + 0.5));
+    rig.vfov_deg = std::min(178.0, std::max(rig.vfov_deg, v + 0.5));
+  }
+  return rig;
+}
+
+// The ground truth of the pad in the ideal image moved into the real camera's image.
+void distort_truth(const camera::CameraModel& real, const Intrinsics& ideal, StereoFrame& f) {
+  double umin = 1e18, umax = -1e18, vmin = 1e18, vmax = -1e18;
+  for (auto& c : f.target_corners) {
+    if (std::isnan(c.x)) continue;
+    const Eigen::Vector2d p = real.project({(c.x - ideal.cx) / ideal.fx, (c.y - ideal.cy) / ideal.fy, 1.0});
+    c = {p.x(), p.y()};
+    umin = std::min(umin, p.x());
+    umax = std::max(umax, p.x());
+    vmin = std::min(vmin, p.y());
+    vmax = std::max(vmax, p.y());
+    if (p.x() < -0.5 || p.y() < -0.5 || p.x() > real.width - 0.5 || p.y() > real.height - 0.5)
+      f.target_visible = false;
+  }
+  if (umin <= umax) f.target_box = cv::Rect2d(umin, vmin, umax - umin, vmax - vmin);
+}
+
 // Wraps an angle to (-pi/2, pi/2]: the helipad's H looks the same after half a turn.
 double wrap_half_turn(double a) {
   a = std::remainder(a, kPi);
@@ -147,10 +190,37 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   RigConfig fwd = cfg_.stereo_rig;
   fwd.exposure = down.exposure / cfg_.down_camera.exposure * fwd.exposure;
   fwd.noise_seed = mix_seed(cfg_.seed, 7005);
+  // The real camera the effects model keeps the configured rig's intrinsics (or its lens
+  // calibration's); the ideal frames it starts from may be wider (ideal_rig).
+  auto real_of = [&](const CameraEffectsConfig& fx, const RigConfig& rig) {
+    return fx.any() ? real_camera(fx, StereoRenderer(world_, rig).intrinsics()) : camera::CameraModel{};
+  };
+  const camera::CameraModel down_real = real_of(cfg_.down_effects, down);
+  const camera::CameraModel fwd_real = real_of(cfg_.stereo_effects, fwd);
+  down = ideal_rig(down, cfg_.down_effects, down_real);
+  fwd = ideal_rig(fwd, cfg_.stereo_effects, fwd_real);
   down_ = StereoRenderer(world_, down);
   forward_ = StereoRenderer(world_, fwd);
+  auto stage = [&](CameraEffectsConfig fx, const camera::CameraModel& real, const Intrinsics& ideal, uint64_t stream,
+                   const std::string& what) {
+    fx.noise.seed = mix_seed(mix_seed(cfg_.seed, stream), fx.noise.seed);
+    if (fx.lens.enabled) fx.lens.model = real;
+    return Effects{CameraEffects(fx, pinhole_of(ideal), what), real};
+  };
+  if (cfg_.down_effects.any())
+    down_fx_ = stage(cfg_.down_effects, down_real, down_.intrinsics(), 7008, "camera_effects.down");
+  if (cfg_.stereo && cfg_.stereo_effects.any()) {
+    left_fx_ = stage(cfg_.stereo_effects, fwd_real, forward_.intrinsics(), 7009, "camera_effects.stereo (left)");
+    right_fx_ = stage(cfg_.stereo_effects, fwd_real, forward_.intrinsics(), 7010, "camera_effects.stereo (right)");
+  }
   std::normal_distribution<double> n01(0.0, 1.0);
   down_calibration_ = down_.intrinsics();
+  if (down_fx_) {  // the real camera's pinhole part (its distortion: down_fx_->real)
+    down_calibration_.fx = down_real.fx;
+    down_calibration_.fy = down_real.fy;
+    down_calibration_.cx = down_real.cx;
+    down_calibration_.cy = down_real.cy;
+  }
   const double focal = 1.0 + cfg_.calibration_error.focal_rel * n01(rng_);
   down_calibration_.fx *= focal;
   down_calibration_.fy *= focal;
@@ -315,6 +385,7 @@ FlightFrame FlightSim::step() {
     const Eigen::Quaterniond q = s.pose().rotation();
     const Eigen::AngleAxisd turn(q_prev_.conjugate() * q);
     const Eigen::Vector3d omega = turn.angle() * turn.axis() / dt;
+    omega_body_ = omega;
     q_prev_ = q;
     f.imu.push_back(imu_.sample(t, q, omega, s.armed ? s.acceleration : Eigen::Vector3d::Zero()));
   };
@@ -339,10 +410,32 @@ FlightFrame FlightSim::step() {
   const geometry::SE3 T_world_body = f.vehicle.pose();
   f.T_world_down = T_world_body * T_body_down_ * vibration(t_);
   f.down = down_.render_mono(f.T_world_down, f.utime, f.seq);
+  if (down_fx_) {
+    f.down.left = down_fx_->stage.apply(f.down.left, f.down.depth, camera_motion(f.T_world_down, T_body_down_),
+                                        f.utime, f.seq);
+    if (down_fx_->stage.config().lens.enabled) distort_truth(down_fx_->real, down_.intrinsics(), f.down);
+  }
   f.T_world_left = T_world_body * T_body_left_ * vibration(t_ + 0.37);
   if (cfg_.stereo) f.stereo = forward_.render(f.T_world_left, f.utime, f.seq);
+  if (f.stereo && left_fx_) {
+    // The right view is shifted along the flow of the left's depth (parallax of the depth
+    // lookup over the baseline neglected) and moves as the left camera does.
+    const CameraMotion m = camera_motion(f.T_world_left, T_body_left_);
+    f.stereo->left = left_fx_->stage.apply(f.stereo->left, f.stereo->depth, m, f.utime, f.seq);
+    f.stereo->right = right_fx_->stage.apply(f.stereo->right, f.stereo->depth, m, f.utime, f.seq);
+    if (left_fx_->stage.config().lens.enabled) distort_truth(left_fx_->real, forward_.intrinsics(), *f.stereo);
+  }
   f.target = target_in(f.T_world_down);
   return f;
+}
+
+CameraMotion FlightSim::camera_motion(const geometry::SE3& T_world_cam, const geometry::SE3& T_body_cam) const {
+  // The body's velocity and angular velocity in the camera frame (the mount's lever arm and
+  // the vibration's own rate neglected).
+  CameraMotion m;
+  m.velocity = T_world_cam.rotation().conjugate() * vehicle_.state().velocity;
+  m.angular_velocity = T_body_cam.rotation().conjugate() * omega_body_;
+  return m;
 }
 
 TargetTruth FlightSim::target_in(const geometry::SE3& T_world_cam) const {

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "common/geometry/se3.hpp"
+#include "common/sim/camera/camera_effects.hpp"
 #include "common/sim/flight/imu.hpp"
 #include "common/sim/flight/multirotor.hpp"
 #include "common/sim/stereo_renderer.hpp"
@@ -71,6 +72,9 @@ struct FlightSimConfig {
   CalibrationError calibration_error;  // of the intrinsics published with CAM_DOWN
   bool stereo = false;             // also render the forward stereo pair
   RigConfig stereo_rig;
+  // Real camera effects on the rendered frames (common/sim/camera); default ideal (off): the
+  // frames are today's, byte for byte. The stereo section applies to both forward cameras.
+  CameraEffectsConfig down_effects, stereo_effects;
   double frame_rate_hz = 20.0;
   WindParams wind;
   VibrationParams vibration;
@@ -196,6 +200,15 @@ class FlightSim {
   int64_t applied_ = 0, refused_ = 0;
   std::string last_refusal_;
   Eigen::Quaterniond q_prev_ = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d omega_body_ = Eigen::Vector3d::Zero();  // of the last physics step, rad/s
+  // The camera-effects stages (only when their config has an effect on) and the real
+  // cameras' models (their projection places the ground truth in the distorted image).
+  struct Effects {
+    CameraEffects stage;
+    camera::CameraModel real;
+  };
+  std::optional<Effects> down_fx_, left_fx_, right_fx_;
+  CameraMotion camera_motion(const geometry::SE3& T_world_cam, const geometry::SE3& T_body_cam) const;
 };
 
 LandingScore score_landing(const FlightSim& sim, double max_error_m = 0.25, double max_yaw_deg = 10.0);
