@@ -28,7 +28,8 @@ double eta(int t, double beta, double q) {
 }
 
 CeResult cross_entropy(const std::vector<CeParameter>& parameters, const CeOptions& opt, const CostFunction& cost,
-                       ThreadPool& pool, const RepairFunction& repair, const IterationCallback& on_iteration) {
+                       ThreadPool& pool, const RepairFunction& repair, const IterationCallback& on_iteration,
+                       const BatchCostFunction& batch_cost) {
   opt.validate();
   const size_t h = parameters.size();
   if (h == 0) throw std::invalid_argument("cross-entropy: no parameters");
@@ -58,10 +59,17 @@ CeResult cross_entropy(const std::vector<CeParameter>& parameters, const CeOptio
       if (repair) repair(xi);
     }
     // Step 3: their costs (in parallel), ordered from smallest.
-    pool.parallel_for(n, [&](size_t i) {
-      const double c = cost(x[i]);
-      costs[i] = std::isnan(c) ? std::numeric_limits<double>::infinity() : c;
-    });
+    if (batch_cost) {
+      costs = batch_cost(x);
+      if (costs.size() != n) throw std::logic_error("cross-entropy: the batch cost returned a cost per candidate too few or many");
+      for (double& c : costs)
+        if (std::isnan(c)) c = std::numeric_limits<double>::infinity();
+    } else {
+      pool.parallel_for(n, [&](size_t i) {
+        const double c = cost(x[i]);
+        costs[i] = std::isnan(c) ? std::numeric_limits<double>::infinity() : c;
+      });
+    }
     res.evaluations += opt.samples;
     std::iota(order.begin(), order.end(), size_t{0});
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return costs[a] < costs[b]; });

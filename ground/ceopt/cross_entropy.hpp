@@ -69,8 +69,12 @@ using CostFunction = std::function<double(const std::vector<double>&)>;
 using RepairFunction = std::function<void(std::vector<double>&)>;
 // Called after each iteration; return false to stop.
 using IterationCallback = std::function<bool(const CeIteration&)>;
+// The costs of one iteration's candidates at once, in their order (aerie-ceopt under MPI: the
+// candidates are the runs of a study over the ranks). When set, it replaces `cost` on the pool.
+using BatchCostFunction = std::function<std::vector<double>(const std::vector<std::vector<double>>&)>;
 
 CeResult cross_entropy(const std::vector<CeParameter>& parameters, const CeOptions& options, const CostFunction& cost,
-                       ThreadPool& pool, const RepairFunction& repair = {}, const IterationCallback& on_iteration = {});
+                       ThreadPool& pool, const RepairFunction& repair = {}, const IterationCallback& on_iteration = {},
+                       const BatchCostFunction& batch_cost = {});
 
 }  // namespace aerie::ceopt

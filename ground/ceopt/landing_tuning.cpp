@@ -72,6 +72,46 @@ std::vector<LandingRun> fly_on(const LandingTuning& problem, const std::vector<d
 
 }  // namespace
 
+namespace {
+
+// tune_landing with every landing flown through `flier`: the same steps in the same order, each
+// CE iteration's candidates as one call.
+LandingTuningResult tune_landing_through(const LandingTuning& problem, const IterationCallback& on_iteration,
+                                         const CandidateCallback& on_candidate, const LandingFlier& flier) {
+  const LandingTuningConfig& cfg = problem.config();
+  LandingTuningResult res;
+  const util::Stopwatch watch;
+  const double cpu0 = process_cpu_seconds();
+  for (const auto& p : cfg.parameters) res.initial.push_back(p.mean);
+  res.initial_training = flier({{res.initial, cfg.training}}).at(0);
+  auto batch_cost = [&](const std::vector<std::vector<double>>& xs) {
+    std::vector<LandingJob> jobs;
+    for (const auto& x : xs) jobs.push_back({x, cfg.training});
+    const auto runs = flier(jobs);
+    std::vector<double> costs;
+    for (size_t i = 0; i < xs.size(); ++i) {
+      costs.push_back(mean_cost(runs.at(i), cfg));
+      if (on_candidate) on_candidate(xs[i], runs[i], costs.back());
+    }
+    return costs;
+  };
+  ThreadPool unused(1);
+  res.ce = cross_entropy(cfg.parameters, cfg.ce, {}, unused, {}, on_iteration, batch_cost);
+  if (!res.ce.best.empty()) {
+    res.tuned_pilot_yaml = pilot_yaml_with(problem.base_pilot_yaml(), problem.names(), res.ce.best);
+    if (res.ce.stop_reason != "cancelled" && cfg.validation.count > 0) {
+      const auto v = flier({{res.initial, cfg.validation}, {res.ce.best, cfg.validation}});
+      res.initial_validation = v.at(0);
+      res.tuned_validation = v.at(1);
+    }
+  }
+  res.seconds = watch.ms() / 1000.0;
+  res.cpu_seconds = process_cpu_seconds() - cpu0;
+  return res;
+}
+
+}  // namespace
+
 LandingTuningConfig default_landing_tuning_config() {
   LandingTuningConfig c;
   c.ce.samples = 10;
@@ -201,7 +241,8 @@ std::vector<LandingRun> LandingTuning::fly(const std::vector<double>& x, const S
 }
 
 LandingTuningResult tune_landing(const LandingTuning& problem, ThreadPool& pool, const IterationCallback& on_iteration,
-                                 const CandidateCallback& on_candidate) {
+                                 const CandidateCallback& on_candidate, const LandingFlier& flier) {
+  if (flier) return tune_landing_through(problem, on_iteration, on_candidate, flier);
   const LandingTuningConfig& cfg = problem.config();
   LandingTuningResult res;
   const util::Stopwatch watch;

@@ -91,11 +91,23 @@ struct LandingTuningResult {
   double seconds = 0, cpu_seconds = 0;        // wall and process CPU time of the whole tuning
 };
 
+// A set of gains flown on a range of seeds: what tune_landing asks to be flown.
+struct LandingJob {
+  std::vector<double> x;
+  SeedRange seeds;
+};
+// Flies every landing of the jobs; each job's runs in seed order. aerie-ceopt under MPI spreads
+// them over the ranks (ground/ceopt/landing_study.hpp): one call per CE iteration.
+using LandingFlier = std::function<std::vector<std::vector<LandingRun>>(const std::vector<LandingJob>&)>;
+
 class ThreadPool;
-// Called as each candidate's landings are done (from the pool's threads, one at a time).
+// Called as each candidate's landings are done (from the pool's threads, one at a time; with a
+// flier, on the calling thread in candidate order).
 using CandidateCallback = std::function<void(const std::vector<double>& x, const std::vector<LandingRun>& runs, double cost)>;
+// Without a flier the landings fly on the pool; with one, through it (the pool then idles): the
+// same landings, the same figures.
 LandingTuningResult tune_landing(const LandingTuning& problem, ThreadPool& pool, const IterationCallback& on_iteration = {},
-                                 const CandidateCallback& on_candidate = {});
+                                 const CandidateCallback& on_candidate = {}, const LandingFlier& flier = {});
 
 // OUT/pilot.yaml (the tuned configuration), OUT/ce_history.csv, OUT/validation.csv and
 // OUT/report.md; returns the files written.

@@ -4,6 +4,9 @@
 // the chosen controller can be sent to aerie-control on FLC_PARAMS.
 // `aerie-ceopt landing` tunes aerie-pilot's landing controller the same way, each candidate
 // flown in lock-step landings (ground/ceopt/landing_tuning.hpp), and writes a pilot.yaml.
+// Started by mpirun/srun, `aerie-ceopt landing` spreads each CE iteration's landings over the
+// ranks (the same elite and gains as one process); --resumable/--resume journal the landings
+// in OUT/studies so that an interrupted tuning continues (ground/ceopt/landing_study.hpp).
 #include <aerie/ce_progress_t.hpp>
 #include <aerie/flc_params_t.hpp>
 #include <spdlog/spdlog.h>
@@ -21,6 +24,7 @@
 #include "common/flc/flc_io.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/time.hpp"
+#include "ground/ceopt/landing_study.hpp"
 #include "ground/ceopt/landing_tuning.hpp"
 #include "ground/ceopt/pipeline.hpp"
 #include "ground/ceopt/report.hpp"
@@ -46,6 +50,8 @@ aerie::flc_params_t params_message(const flc::FlcSpec& spec, int64_t seq) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  study::Session session(argc, argv);  // MPI only when mpirun/srun started us (docs/scale.md)
+  const bool writer = session.rank() == 0;
   CLI::App app{"aerie-ceopt: cross-entropy optimisation of the heading fuzzy controller in simulation (thesis 5.1.4-5.1.6)"};
   util::CommonOptions common;
   util::add_common_options(app, common);
@@ -80,7 +86,23 @@ int main(int argc, char** argv) {
   std::string node_log_level = "warn";
   landing->add_option("--node-log-level", node_log_level, "the flown nodes' log level (info shows every pilot transition)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
-  CLI11_PARSE(app, argc, argv);
+  std::string resume_dir;
+  bool resumable = false;
+  double rank_timeout_s = 600;
+  landing->add_flag("--resumable", resumable,
+                    "journal every landing in OUT/studies (always so under mpirun), so that --resume can continue");
+  landing->add_option("--resume", resume_dir,
+                      "continue the tuning in this folder (started with --resumable or under mpirun, with the same options): "
+                      "the landings in its journals are not flown again");
+  landing->add_option("--rank-timeout", rank_timeout_s,
+                      "under MPI: seconds a rank may take over one landing before the tuning stops, naming it")
+      ->check(CLI::PositiveNumber);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return writer ? app.exit(e) : e.get_exit_code();  // the help or the error, once
+  }
+  if (!resume_dir.empty()) out = resume_dir;
   util::init_logging("ceopt", common.log_level);
   // The tuning's own progress; in landing mode the nodes flown log through the default
   // logger at --node-log-level (their transitions would flood the terminal).
@@ -92,6 +114,12 @@ int main(int argc, char** argv) {
 
   try {
     const bool landing_mode = landing->parsed();
+    if (session.distributed() && !landing_mode) {
+      if (writer)
+        spdlog::error("under mpirun only `aerie-ceopt landing` spreads over the ranks; run the FLC tuning in one process "
+                      "(--threads)");
+      return 2;
+    }
     if (landing_mode && runs > 0) throw std::runtime_error("--runs is the avoidance experiment's; landing uses --training/--validation");
     CeoptConfig cfg;
     LandingTuningConfig landing_cfg;
@@ -111,6 +139,13 @@ int main(int argc, char** argv) {
     if (iterations > 0) ce.max_iterations = iterations;
     if (samples > 0) ce.samples = samples;
     ce.validate();
+    std::unique_ptr<const LandingTuning> problem_ptr;
+    if (landing_mode) problem_ptr = std::make_unique<const LandingTuning>(landing_cfg);
+    if (!writer) {  // the other ranks fly what rank 0 hands out, and write nothing
+      cv::setNumThreads(1);
+      serve_landing_studies(*problem_ptr, session);
+      return 0;
+    }
 
     std::unique_ptr<bus::Bus> lcm;
     std::unique_ptr<bus::StatusReporter> status;
@@ -167,8 +202,8 @@ int main(int argc, char** argv) {
     };
 
     if (landing_mode) {
-      const LandingTuning problem(landing_cfg);
-      if (pool.size() > 1) cv::setNumThreads(1);  // one core per landing
+      const LandingTuning& problem = *problem_ptr;
+      if (pool.size() > 1 || session.distributed()) cv::setNumThreads(1);  // one core per landing
       const auto names = problem.names();
       int candidates = 0;
       auto on_candidate = [&](const std::vector<double>& x, const std::vector<LandingRun>& runs, double cost) {
@@ -177,8 +212,12 @@ int main(int argc, char** argv) {
         const auto ok = std::count_if(runs.begin(), runs.end(), [](const LandingRun& r) { return r.success; });
         log->info("candidate {:3d}: cost {:.4f}, {}/{} landed in bounds |{}", ++candidates, cost, ok, runs.size(), gains.str());
       };
+      LandingFlier flier;  // without mpirun, --resumable or --resume: the pool, as always
+      if (session.distributed() || resumable || !resume_dir.empty())
+        flier = landing_study_flier(problem, {out + "/studies", !resume_dir.empty(), pool.size(), rank_timeout_s}, session);
       const LandingTuningResult result =
-          tune_landing(problem, pool, [&](const CeIteration& it) { return on_iteration(1, names, it); }, on_candidate);
+          tune_landing(problem, pool, [&](const CeIteration& it) { return on_iteration(1, names, it); }, on_candidate, flier);
+      end_landing_studies(session);
       const auto files = write_landing_report(out, problem, result, cmdline.str());
       log->info("best training cost {:.4f} (initial {:.4f}) after {} candidates in {:.0f} s ({:.0f} s CPU); wrote {} files to {}",
                    result.ce.best_cost, mean_cost(result.initial_training, landing_cfg), result.ce.evaluations, result.seconds,
@@ -242,7 +281,8 @@ int main(int argc, char** argv) {
     if (status) status->publish_now();
     return complete ? 0 : 130;
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
+    spdlog::error("{}{}", session.distributed() ? "rank " + std::to_string(session.rank()) + ": " : std::string(), e.what());
+    if (session.distributed()) session.abort(1);  // the other ranks wait for rank 0's next batch
     return 1;
   }
 }

@@ -128,4 +128,10 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
 std::string csv_header();
 std::string csv_row(const std::string& sweep, const RunSpec& spec, const RunRow& row);
 
+// A row as a study note (tools/study) and back, every field exact (row_note.cpp): how a run
+// flown on another MPI rank, or before a --resume, reaches the CSV and the report. The reader
+// throws std::runtime_error naming `what` when the note is not a row's.
+std::string row_note(const RunRow& row);
+RunRow row_from_note(const std::string& note, const std::string& what);
+
 }  // namespace aerie::linkstudy
