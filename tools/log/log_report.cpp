@@ -22,7 +22,9 @@
 #include <stdexcept>
 
 #include "common/bus/wire.hpp"
-#include "ground/map/octomap_message.hpp"
+#ifdef AERIE_REPORT_MAP
+#include "ground/map/octomap_message.hpp"  // the ground side only: the air-only build has no OctoMap
+#endif
 #include "tools/eval/metrics.hpp"
 #include "tools/latency/latency.hpp"
 #include "tools/log/type_registry.hpp"
@@ -272,6 +274,9 @@ class Collector {
   // The occupied voxels of the last full map (or of the last message when none was full).
   void write_map() {
     if (map_.empty()) return;
+#ifndef AERIE_REPORT_MAP
+    notes_.push_back(std::string(kMapOctomap) + ": not drawn (this aerie-log is an air-only build, without OctoMap)");
+#else
     aerie::octomap_t m;
     if (!bus::decode_bounded(map_.data(), map_.size(), m)) return;
     std::unique_ptr<octomap::OcTree> tree;
@@ -284,6 +289,7 @@ class Collector {
     Csv& c = open("map", "x,y,z,size");
     for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it)
       if (tree->isNodeOccupied(*it)) c.row(num(it.getX()), num(it.getY()), num(it.getZ()), num(it.getSize()));
+#endif
   }
 
   // NAV_STATE against the truth (SIM_STATE's body origin, else GT_POSE's camera): for each truth
