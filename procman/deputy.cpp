@@ -282,6 +282,7 @@ bool Deputy::start(Command& c, int64_t now) {
   c.sigkill_sent = false;
   c.stop_targets.clear();
   c.last_jiffies = 0;
+  c.last_host_jiffies = read_host().total_jiffies;
   c.cpu_usage = 0;
   return true;
 }
@@ -441,10 +442,14 @@ void Deputy::sample_usage() {
       vsize += p.vsize_bytes;
       rss += p.rss_bytes;
     }
-    // cpu_usage: fraction of the whole host's CPU time (libbot2's convention).
-    if (c.last_jiffies > 0 && jiffies >= c.last_jiffies && dtotal > 0)
-      c.cpu_usage = static_cast<float>(static_cast<double>(jiffies - c.last_jiffies) / static_cast<double>(dtotal));
+    // cpu_usage: fraction of the whole host's CPU time (libbot2's convention), since the last
+    // sample or the start. (Waiting for a previous sample with jiffies > 0 left a new command at
+    // 0 % for its first two or three reports, issue 49.)
+    const uint64_t dhost = h.total_jiffies - c.last_host_jiffies;
+    if (c.last_host_jiffies > 0 && jiffies >= c.last_jiffies && dhost > 0 && h.total_jiffies >= c.last_host_jiffies)
+      c.cpu_usage = static_cast<float>(static_cast<double>(jiffies - c.last_jiffies) / static_cast<double>(dhost));
     c.last_jiffies = jiffies;
+    c.last_host_jiffies = h.total_jiffies;
     c.vsize_bytes = vsize;
     c.rss_bytes = rss;
   }

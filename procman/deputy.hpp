@@ -73,8 +73,10 @@ class Deputy {
     int32_t restarts = 0;            // automatic respawns
     std::vector<pid_t> stop_targets;  // processes signalled when stopping
     std::string superseded_name;     // the running process is an earlier command of this id, being stopped
-    // usage over the last sampling period
+    // usage over the last sampling period: the command's CPU time and the host's total at the
+    // last sample, or at the start (a new process has used none), so the first sample has a CPU figure
     uint64_t last_jiffies = 0;
+    uint64_t last_host_jiffies = 0;
     float cpu_usage = 0;
     int64_t vsize_bytes = 0, rss_bytes = 0;
 

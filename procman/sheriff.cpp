@@ -311,11 +311,17 @@ std::string Sheriff::table(int64_t now_ms) const {
       const int st = c.last.exit_code;
       exit_text = WIFSIGNALED(st) ? "signal " + std::to_string(WTERMSIG(st)) : "code " + std::to_string(WEXITSTATUS(st));
     }
-    std::snprintf(line, sizeof line, "%-8s %-20s %-14s %-11s %8d %5.1f%% %9.1f %8d  %s\n", c.host.c_str(),
+    // A running process always has resident pages: RSS 0 is a report the deputy sent before it
+    // sampled the command (it samples once a second; the report of the start comes at once), shown
+    // as "-", not as 0 % and 0 MiB (issue 49: a script's last table showed every command so).
+    char cpu[16] = "-", rss[16] = "-";
+    if (!c.reported || c.last.pid == 0 || c.last.mem_rss_bytes != 0) {
+      std::snprintf(cpu, sizeof cpu, "%.1f%%", c.reported ? 100.0 * c.last.cpu_usage : 0.0);
+      std::snprintf(rss, sizeof rss, "%.1f", c.reported ? static_cast<double>(c.last.mem_rss_bytes) / 1048576.0 : 0.0);
+    }
+    std::snprintf(line, sizeof line, "%-8s %-20s %-14s %-11s %8d %6s %9s %8d  %s\n", c.host.c_str(),
                   c.cmd.command_name.substr(0, 20).c_str(), c.cmd.group.substr(0, 14).c_str(), to_string(s),
-                  c.reported ? c.last.pid : 0, c.reported ? 100.0 * c.last.cpu_usage : 0.0,
-                  c.reported ? static_cast<double>(c.last.mem_rss_bytes) / 1048576.0 : 0.0, c.restarts,
-                  exit_text.c_str());
+                  c.reported ? c.last.pid : 0, cpu, rss, c.restarts, exit_text.c_str());
     os << line;
   }
   return os.str();

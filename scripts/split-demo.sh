@@ -118,6 +118,17 @@ else
   echo "split-demo: one LCM network, $AIR_URL, across the veth"
 fi
 
+# The ground logger asks for a 4 MiB socket buffer (config/split.pmd); the kernel caps it at
+# net.core.rmem_max (not per namespace), 208 KiB by default.
+rmem_max=$(cat /proc/sys/net/core/rmem_max 2>/dev/null || echo 0)
+if [[ $rmem_max -lt 4194304 ]]; then
+  if echo 4194304 2>/dev/null >/proc/sys/net/core/rmem_max; then
+    echo "split-demo: raised net.core.rmem_max from $rmem_max to 4194304 (the logger's receive buffer)"
+  else
+    echo "split-demo: could not raise net.core.rmem_max from $rmem_max: the logger may lose image bursts" >&2
+  fi
+fi
+
 mkdir -p "$(dirname "$LOG")"
 # The commands inherit the deputy's environment: their LCM URL and the log name.
 # Keyed procman (docs/procman.md "Keyed mode"): one mission key for this run, in the run's temp folder.
@@ -149,3 +160,6 @@ if [[ $LINK -eq 1 ]]; then
 fi
 echo
 "$BIN/aerie-latency" "$LOG"
+# What the recorder missed (sequence gaps that are not a producer's skipped frames, aerie-log info).
+lost=$("$BIN/aerie-log" info "$LOG" 2>/dev/null | grep '^logger lost:' || true)
+echo "split-demo: ground ${lost:-logger lost: unknown (aerie-log info $LOG failed)}"

@@ -2,7 +2,7 @@
 // trackers: the library's fhog() against the scalar reference it replaced
 // (tests/air/track/fhog_reference.hpp), interleaved in one run on one thread, on a 256x256 BGR
 // patch (a DCF search window), a 640x480 grey frame and a 1280x720 grey frame.
-//   aerie-bench-fhog-micro [repetitions]     (default 200; median microseconds per call)
+//   aerie-bench-fhog-micro [REPETITIONS]     (default 200; median microseconds per call)
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -51,8 +51,24 @@ double time_us(F&& f) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  int reps = 200;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "-h" || arg == "--help") {
+      std::printf("aerie-bench-fhog-micro: FHOG (air/track/dcf) against its scalar reference, median us per call\n"
+                  "Usage: aerie-bench-fhog-micro [REPETITIONS]   (a positive integer, default 200)\n");
+      return 0;
+    }
+    char* end = nullptr;
+    const long n = std::strtol(arg.c_str(), &end, 10);
+    if (i > 1 || arg.empty() || *end != '\0' || n < 1 || n > 1000000) {
+      std::fprintf(stderr, "aerie-bench-fhog-micro: unexpected argument '%s': expected REPETITIONS in [1, 1000000] (see --help)\n",
+                   argv[i]);
+      return 2;
+    }
+    reps = static_cast<int>(n);
+  }
   cv::setNumThreads(1);
-  const int reps = argc > 1 ? std::max(1, std::atoi(argv[1])) : 200;
   struct Case {
     const char* name;
     cv::Mat image;

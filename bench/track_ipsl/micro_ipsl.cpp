@@ -4,6 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <cstdio>
+
 #include "air/track/ipsl/appearance.hpp"
 
 using namespace aerie::track;
@@ -44,6 +46,22 @@ void BM_Score(benchmark::State& state) {
 }
 BENCHMARK(BM_Score)->Arg(100)->Arg(300);
 
+void print_help() {
+  std::printf(
+      "aerie-bench-ipsl-micro: micro-benchmarks of the IPSL hot loops (observation warp, subspace scoring)\n"
+      "Options (Google Benchmark's):\n");
+  benchmark::PrintDefaultHelp();
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv, print_help);  // --help prints print_help() and exits 0
+  if (argc > 1) {
+    std::fprintf(stderr, "aerie-bench-ipsl-micro: unknown option '%s' (see --help)\n", argv[1]);
+    return 2;
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

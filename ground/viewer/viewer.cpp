@@ -14,14 +14,25 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "air/track/factory.hpp"
+#include "air/track/node/default_tracker.hpp"
 #include "common/bus/node.hpp"
 #include "common/util/heap.hpp"
 #include "common/util/time.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
+#include "tools/cmd/command.hpp"
 
 namespace aerie::viewer {
+
+std::vector<std::string> tracker_cycle() {
+  std::vector<std::string> names{track::kDefaultTracker};
+  for (const auto& list : {track::aerie_tracker_names(), track::opencv_tracker_names()})
+    for (const auto& name : list)
+      if (name != names.front()) names.push_back(name);
+  return names;
+}
 
 struct Viewer::Help {
   vtkSmartPointer<vtkTextActor> text = vtkSmartPointer<vtkTextActor>::New();
@@ -258,19 +269,11 @@ std::optional<cv::Rect2d> Viewer::end_selection(double x, double y) {
 }
 
 void Viewer::send_track_command(int8_t command, const std::optional<cv::Rect2d>& box) {
-  aerie::track_cmd_t cmd{};
-  cmd.utime = message_time();
-  cmd.seq = cmd_seq_++;
-  cmd.command = command;
-  cmd.tracker = current_tracker();
-  cmd.camera = options_.image_channel;
-  if (box) {
-    cmd.x = box->x;
-    cmd.y = box->y;
-    cmd.width = box->width;
-    cmd.height = box->height;
-  }
-  cmd.nparams = 0;
+  std::optional<aerie::cmd::Box> b;
+  if (box) b = aerie::cmd::Box{box->x, box->y, box->width, box->height};
+  // The message aerie-cmd sends (tools/cmd/command.hpp): one builder for both operators.
+  const aerie::track_cmd_t cmd =
+      aerie::cmd::track_command(command, current_tracker(), options_.image_channel, b, message_time(), cmd_seq_++);
   bus_.publish(options_.track_cmd_channel, cmd);
   spdlog::info("TRACK_CMD {} tracker={} box=({:.0f},{:.0f},{:.0f},{:.0f})", command, cmd.tracker, cmd.x, cmd.y,
                cmd.width, cmd.height);

@@ -22,6 +22,11 @@
 
 namespace aerie::viewer {
 
+// The 't' key's cycle: aerie-track's default tracker (air/track/node/default_tracker.hpp)
+// first, then every other tracker the factory builds (air/track/factory.hpp), ours then
+// OpenCV's references.
+std::vector<std::string> tracker_cycle();
+
 struct ViewerOptions {
   int width = 1280;
   int height = 800;
@@ -46,7 +51,7 @@ struct ViewerOptions {
   double trim_period_s = 10;
   std::string image_channel = "CAM_LEFT";
   std::string track_cmd_channel = "TRACK_CMD";
-  std::vector<std::string> trackers = {"amcmr-ct", "am3", "ipsl-mr", "ct", "mil", "ipsl"};
+  std::vector<std::string> trackers = tracker_cycle();
 };
 
 class Viewer {

@@ -334,6 +334,24 @@ TEST(Deputy, ShutdownLeavesNothingRunning) {
   for (pid_t p : children) EXPECT_FALSE(alive(p)) << p;
 }
 
+// Issue 49: the first sample after a start had no CPU figure (it waited for a previous sample
+// with CPU time), so a busy command showed 0 % for its first reports. A new process has used
+// none: the first sample measures from the start.
+TEST(Deputy, TheFirstSampleAfterTheStartHasACpuFigure) {
+  DeputyHarness h;
+  CmdSpec c;
+  c.exec = "sh -c 'while :; do :; done'";
+  h.order({c});
+  h.run_for(500);
+  h.deputy.sample_usage();
+  const auto info = h.deputy.report(0);
+  ASSERT_EQ(info.ncmds, 1);
+  ASSERT_GT(info.cmds[0].pid, 0);
+  EXPECT_GT(info.cmds[0].cpu_usage, 0.02f);
+  EXPECT_LE(info.cmds[0].cpu_usage, 1.0f);
+  EXPECT_GT(info.cmds[0].mem_rss_bytes, 0);
+}
+
 TEST(Deputy, ReportsCpuAndMemory) {
   DeputyHarness h;
   CmdSpec c;

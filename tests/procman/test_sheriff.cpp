@@ -182,6 +182,27 @@ TEST(Sheriff, HostileMemoryFiguresDoNotOverflowTheTable) {
   EXPECT_NE(table.find("-8796097662976/"), std::string::npos) << table;
 }
 
+// Issue 49: a script's last table (--script start_all --on-script-complete exit) showed 0.0 %
+// and 0.0 MiB for every running command: the deputy reports a start at once, before its next
+// sample. Such a report (running, RSS 0) is shown as "-"; a sampled one with its figures.
+TEST(Sheriff, TheTableShowsADashForARunningCommandNotSampledYet) {
+  Sheriff s("sh");
+  s.load(parse_pmd(kConfig));
+  const int32_t id = s.find_by_name("sleeper")->sheriff_id;
+  auto row = [&](int64_t now) {
+    const std::string table = s.table(now);
+    const size_t at = table.find("sleeper");
+    return at == std::string::npos ? std::string() : table.substr(at, table.find('\n', at) - at);
+  };
+  bot_procman::deputy_cmd2_t d = reported(id, "sleeper", 100, 1);
+  d.cpu_usage = 0;
+  d.mem_vsize_bytes = d.mem_rss_bytes = 0;
+  s.on_info(info("testhost", {d}), 0);
+  EXPECT_EQ(row(0), "sleeper              vision         running          100      -         -        0  -") << row(0);
+  s.on_info(info("testhost", {reported(id, "sleeper", 100, 1)}), 1000);  // sampled: 25 %, 1 MiB
+  EXPECT_EQ(row(1000), "sleeper              vision         running          100  25.0%       1.0        0  -") << row(1000);
+}
+
 TEST(Sheriff, CountsRespawnsFromPidChanges) {
   Sheriff s("sh");
   s.load(parse_pmd(kConfig));

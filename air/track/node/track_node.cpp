@@ -199,6 +199,8 @@ TrackNode::~TrackNode() {
   {
     std::lock_guard lk(mutex_);
     stop_ = true;
+    if (image_probe_) bus_.unsubscribe(*image_probe_);
+    image_probe_ = nullptr;
   }
   wake_.notify_all();
   taken_.notify_all();
@@ -291,6 +293,7 @@ void TrackNode::report(bus::StatusReporter& status) {
       spdlog::warn("{}", *change);
     }
   }
+  watch_waiting_init(now);
   const bool stale = camera_clock_.stale(now);
   counters_[opt_.camera_channel + ".stale"] = stale ? 1 : 0;
   for (const auto& [name, value] : counters_) status.set(name, value);
@@ -303,7 +306,60 @@ void TrackNode::report(bus::StatusReporter& status) {
     status.ok(tracker_name_.empty() ? "idle" : "tracking with " + tracker_name_);
   }
   if (stale) status.warn(stale_message_);
+  if (!init_wait_message_.empty()) status.warn(init_wait_message_ = waiting_init_message(now));
   if (hop_source_ != 0) status.mark_hop(hop_source_, hop_receive_, hop_publish_);
+}
+
+void TrackNode::watch_waiting_init(int64_t now) {
+  if (!init_waiting_) {
+    if (image_probe_) bus_.unsubscribe(*image_probe_);
+    image_probe_ = nullptr;
+    image_channels_.clear();
+    init_waiting_since_ = 0;
+    init_wait_message_.clear();
+    return;
+  }
+  if (init_waiting_since_ == 0) init_waiting_since_ = now;
+  if (!image_probe_) {
+    // Undecoded and bounded: the fingerprint names the type; a full queue drops the newest.
+    image_probe_ = &bus_.subscribe_raw(".*", [this](const uint8_t* data, size_t size, const bus::ReceiveInfo& info) {
+      if (size < 8) return;
+      int64_t hash = 0;
+      for (int i = 0; i < 8; ++i) hash = static_cast<int64_t>(static_cast<uint64_t>(hash) << 8 | data[i]);
+      const char* type = hash == aerie::image_t::getHash()          ? "image_t"
+                         : hash == aerie::stereo_image_t::getHash() ? "stereo_image_t"
+                                                                    : nullptr;
+      std::lock_guard lk(mutex_);
+      if (type && image_channels_.size() < 64) image_channels_.emplace(info.channel, type);
+    }, 4);
+  }
+  if (init_wait_message_.empty() && now - init_waiting_since_ >= static_cast<int64_t>(opt_.init_wait_warn_s * 1e6)) {
+    init_wait_message_ = waiting_init_message(now);
+    ++counters_["init_waits_without_frames"];
+    spdlog::warn("{}", init_wait_message_);
+  }
+}
+
+std::string TrackNode::waiting_init_message(int64_t now) const {
+  std::ostringstream m;
+  m << "INIT seq " << waiting_init_seq_ << " waits: no frame on " << opt_.camera_channel << " ("
+    << (opt_.stereo ? "stereo_image_t" : "image_t") << ") for " << std::fixed;
+  m.precision(1);
+  m << (now - init_waiting_since_) / 1e6 << " s; ";
+  if (const auto it = counters_.find("frames_received"); it != counters_.end() && it->second > 0)
+    m << it->second << " received there but none usable (decode_errors, time_jumps); ";
+  if (image_channels_.empty()) {
+    m << "no channel carries images (is the camera running?)";
+  } else {
+    m << "images are on";
+    const char* sep = " ";
+    for (const auto& [channel, type] : image_channels_) {
+      m << sep << channel << " (" << type << ")";
+      sep = ", ";
+    }
+    m << ": start aerie-track with --camera CHANNEL (and --stereo for stereo_image_t)";
+  }
+  return m.str();
 }
 
 bool TrackNode::wait_idle(int timeout_ms) {
@@ -371,6 +427,11 @@ void TrackNode::run() {
         count("command_errors");
         fail(opt_.command_channel + ": " + e.what());
       }
+    }
+    {
+      std::lock_guard lk(mutex_);
+      init_waiting_ = deferred_.has_value();
+      if (deferred_) waiting_init_seq_ = deferred_->seq;
     }
     if (frame && opt_.init_from_gt >= 0 && !gt_init_done_ && !tracker_ && frames_seen_ > opt_.init_from_gt) {
       std::optional<aerie::gt_box_t> gt;

@@ -10,6 +10,13 @@
 // The LCM thread only stores the newest frame and queues commands; a worker thread decodes
 // and tracks. When the worker falls behind, older frames are replaced by newer ones and
 // counted as skipped: the camera is never blocked.
+//
+// An INIT that arrives before the first frame waits for it. While one waits, the node listens
+// to every channel (pattern ".*", undecoded: only the 8-byte fingerprint is read) to learn which
+// channels carry aerie.image_t or aerie.stereo_image_t; after init_wait_warn_s without a frame
+// it warns once (log) and in status until a frame comes, naming them. The probe exists only
+// during such a wait: LCM reassembles a channel's messages only when someone subscribes to it,
+// so the node pays for the other cameras' images only while it is waiting in vain.
 #include <aerie/gt_box_t.hpp>
 #include <aerie/image_t.hpp>
 #include <aerie/stereo_image_t.hpp>
@@ -27,6 +34,7 @@
 #include <thread>
 
 #include "air/track/landing/pad_pose.hpp"
+#include "air/track/node/default_tracker.hpp"
 #include "air/track/landing/target_pose.hpp"
 #include "air/track/tracker.hpp"
 #include "common/bus/bus.hpp"
@@ -48,7 +56,7 @@ struct NodeOptions {
   std::string track_channel = "TRACK";
   std::string pose_channel = "TARGET_POSE";
   std::string gt_channel = "GT_TRACK";
-  std::string tracker = "eco";  // used by INIT commands that name none
+  std::string tracker = kDefaultTracker;  // used by INIT commands that name none
   uint64_t seed = 1;
   util::Config trackers;  // per-tracker parameter sections (track.yaml "trackers:")
   int max_points = 200;   // sample positions per level published for display
@@ -73,6 +81,8 @@ struct NodeOptions {
   // [65536, 67108864]); beyond, the oldest are dropped (commands_dropped.queue_full).
   int max_queued_commands = 32;
   int64_t max_queued_bytes = int64_t{1} << 20;
+  // An INIT waiting this long with no frame on camera_channel is warned about (class comment).
+  double init_wait_warn_s = 3.0;
 };
 
 // Limits of one TRACK_CMD, checked when it arrives (before it is queued): a command beyond
@@ -127,6 +137,9 @@ class TrackNode {
   int64_t max_pixels() const;
   void count(const std::string& name, int64_t n = 1);
   void fail(const std::string& message);
+  // The INIT-without-frames watch (class comment); called by report() with mutex_ held.
+  void watch_waiting_init(int64_t now);
+  std::string waiting_init_message(int64_t now) const;
 
   bus::Bus& bus_;
   NodeOptions opt_;
@@ -146,6 +159,14 @@ class TrackNode {
   util::NodeClock now_;
   util::MessageClock camera_clock_;  // the message-time policy of the camera channel
   std::string stale_message_;
+  // An INIT waits for the first frame (set by the worker); since when (report()'s clock), the
+  // probe of image channels, what it heard (channel -> message type), the warning given.
+  bool init_waiting_ = false;
+  int64_t waiting_init_seq_ = 0;
+  int64_t init_waiting_since_ = 0;
+  bus::Subscription* image_probe_ = nullptr;
+  std::map<std::string, std::string> image_channels_;
+  std::string init_wait_message_;
 
   // Worker state.
   // The INIT waiting for the first frame: only the newest (a later INIT or a STOP supersedes it).

@@ -629,3 +629,82 @@ TEST_F(NodeTest, IpslCountsOverriddenByACommandAreBounded) {
   EXPECT_EQ(tracks_.back().status, aerie::track_t::TRACKING);
   EXPECT_EQ(tracks_.back().tracker, "amcmr-ct");
 }
+
+// Issue 49: an INIT waited forever, silently, when the camera published on another channel
+// (CAM_MONO) than the node's (CAM_LEFT). After init_wait_warn_s the node warns once and says
+// in status which channels carry images; the probe that learns them is gone once frames come.
+TEST_F(NodeTest, AnInitWithoutFramesWarnsOnceNamingTheChannelsThatCarryImages) {
+  int64_t now = 1'000'000'000;
+  const size_t subscriptions = bus_.subscriptions().size();
+  TrackNode node(bus_, NodeOptions{}, [&] { return now; });
+  const size_t node_subscriptions = bus_.subscriptions().size();
+  aerie::bus::StatusReporter status(bus_, "track");
+  aerie::track_cmd_t init{};
+  init.command = aerie::track_cmd_t::INIT;
+  init.seq = 7;
+  init.tracker = "amcmr-ct";
+  const cv::Rect2d box = scene_.box(motion(0));
+  init.x = box.x, init.y = box.y, init.width = box.width, init.height = box.height;
+  bus_.publish("TRACK_CMD", init);
+  settle(node);
+  node.report(status);  // the wait is seen: the probe listens
+  EXPECT_EQ(bus_.subscriptions().size(), node_subscriptions + 1);
+  EXPECT_EQ(status.message(), "idle");
+
+  bus_.publish("CAM_MONO", frame(0));
+  aerie::stereo_image_t st{};
+  st.left = st.right = frame(0);
+  bus_.publish("CAM_STEREO", st);
+  aerie::gt_box_t gt{};  // not an image
+  bus_.publish("GT_TRACK", gt);
+  settle(node);
+  now += 2'900'000;
+  node.report(status);
+  EXPECT_EQ(status.counter("init_waits_without_frames"), 0);
+  EXPECT_EQ(status.message(), "idle");
+
+  now += 200'000;
+  node.report(status);
+  EXPECT_EQ(status.counter("init_waits_without_frames"), 1);
+  EXPECT_EQ(status.message(),
+            "INIT seq 7 waits: no frame on CAM_LEFT (image_t) for 3.1 s; images are on CAM_MONO (image_t), "
+            "CAM_STEREO (stereo_image_t): start aerie-track with --camera CHANNEL (and --stereo for stereo_image_t)");
+  now += 5'000'000;
+  node.report(status);
+  EXPECT_EQ(status.counter("init_waits_without_frames"), 1);  // warned once, still in status
+  EXPECT_EQ(status.message().rfind("INIT seq 7 waits: no frame on CAM_LEFT (image_t) for 8.1 s;", 0), 0u)
+      << status.message();
+
+  // A frame comes: the INIT runs, the warning and the probe go.
+  bus_.publish("CAM_LEFT", frame(0));
+  settle(node);
+  node.report(status);
+  ASSERT_EQ(tracks_.size(), 1u);
+  EXPECT_EQ(tracks_[0].status, aerie::track_t::TRACKING);
+  EXPECT_EQ(status.message(), "tracking with amcmr-ct");
+  EXPECT_EQ(bus_.subscriptions().size(), node_subscriptions);
+  EXPECT_GT(node_subscriptions, subscriptions);
+}
+
+TEST_F(NodeTest, AnInitWithoutFramesAndNoImagesAnywhereSaysSo) {
+  int64_t now = 1'000'000'000;
+  NodeOptions opt;
+  opt.init_wait_warn_s = 1.0;
+  TrackNode node(bus_, opt, [&] { return now; });
+  aerie::bus::StatusReporter status(bus_, "track");
+  send_init(scene_.box(motion(0)), "amcmr-ct");
+  settle(node);
+  node.report(status);
+  now += 1'000'000;
+  node.report(status);
+  EXPECT_EQ(status.counter("init_waits_without_frames"), 1);
+  EXPECT_EQ(status.message(),
+            "INIT seq 0 waits: no frame on CAM_LEFT (image_t) for 1.0 s; no channel carries images (is the camera running?)");
+  // A STOP cancels the wait: the warning goes.
+  aerie::track_cmd_t stop{};
+  stop.command = aerie::track_cmd_t::STOP;
+  bus_.publish("TRACK_CMD", stop);
+  settle(node);
+  node.report(status);
+  EXPECT_EQ(status.message(), "idle");
+}
