@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "bench/benchmark_main.hpp"
 #include "common/seal/operator.hpp"
 #include "common/seal/seal.hpp"
 
@@ -143,4 +144,8 @@ BENCHMARK(BM_CommandVerify);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return aerie::bench::benchmark_main(argc, argv, "aerie-bench-seal",
+                                      "micro-benchmarks of the sealed door: seal and open per datagram and MB/s, a "
+                                      "stereo pair, the operator's signature on a command");
+}

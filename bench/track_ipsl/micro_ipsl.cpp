@@ -2,6 +2,8 @@
 // observations against a 16-vector subspace (eqs. 3.8-3.10).
 #include <benchmark/benchmark.h>
 
+#include "bench/benchmark_main.hpp"
+
 #include <opencv2/imgproc.hpp>
 
 #include <cstdio>
@@ -46,22 +48,10 @@ void BM_Score(benchmark::State& state) {
 }
 BENCHMARK(BM_Score)->Arg(100)->Arg(300);
 
-void print_help() {
-  std::printf(
-      "aerie-bench-ipsl-micro: micro-benchmarks of the IPSL hot loops (observation warp, subspace scoring)\n"
-      "Options (Google Benchmark's):\n");
-  benchmark::PrintDefaultHelp();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv, print_help);  // --help prints print_help() and exits 0
-  if (argc > 1) {
-    std::fprintf(stderr, "aerie-bench-ipsl-micro: unknown option '%s' (see --help)\n", argv[1]);
-    return 2;
-  }
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return aerie::bench::benchmark_main(
+      argc, argv, "aerie-bench-ipsl-micro",
+      "micro-benchmarks of the IPSL hot loops (observation warp, subspace scoring)");
 }

@@ -26,11 +26,7 @@ const fs::path kBin = fs::path(AERIE_BINARY_DIR) / "bin";
 
 // Executables whose --help lacks a description line, each with the reason. (No Java tool is
 // installed in bin/: lcm-spy runs from lcm.jar, docs/logs.md.)
-const std::map<std::string, std::string> kNoDescription = {
-    {"aerie-bench-seal",
-     "BENCHMARK_MAIN(): Google Benchmark's flag list only (bench/seal/bench_seal.cpp, not part of this change; "
-     "bench/track_ipsl/micro_ipsl.cpp shows the fix)"},
-};
+const std::map<std::string, std::string> kNoDescription = {};
 
 std::vector<std::string> executables() {
   std::vector<std::string> names;
