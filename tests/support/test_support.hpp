@@ -2,6 +2,9 @@
 // Helpers shared by the test suites.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -48,6 +51,24 @@ void expect_refusals(Load&& load, const std::vector<std::pair<std::string, std::
     const std::string e = refusal(load, text);
     EXPECT_NE(e.find(why), std::string::npos) << text << " -> " << (e.empty() ? "accepted" : e);
   }
+}
+
+// What a command run through the shell printed on stdout, and its exit status (-1 when it did
+// not exit normally). Redirect stderr in `command` ("2>&1", "2>FILE") to see it.
+struct ToolRun {
+  int rc = -1;
+  std::string out;
+};
+inline ToolRun run_tool(const std::string& command) {
+  ToolRun r;
+  FILE* p = ::popen(command.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(p);
+  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
 }
 
 }  // namespace aerie::test

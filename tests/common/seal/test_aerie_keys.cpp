@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/seal/keys.hpp"
+#include "tests/support/test_support.hpp"
 
 namespace {
 
@@ -23,23 +24,9 @@ using aerie::seal::load_key;
 
 const std::string kTool = AERIE_BINARY_DIR "/bin/aerie-keys";
 
-struct ToolRun {
-  int rc = -1;
-  std::string out;  // stdout and stderr
-};
-
-ToolRun run(const std::string& args) {
-  ToolRun r;
-  const std::string cmd = "'" + kTool + "' " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+// stdout and stderr together.
+using aerie::test::ToolRun;
+ToolRun run(const std::string& args) { return aerie::test::run_tool("'" + kTool + "' " + args + " 2>&1"); }
 
 std::string file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -30,23 +31,15 @@ struct ToolRun {
   std::string err;
 };
 
+// stdout and stderr apart (stderr through a file).
 ToolRun run(const std::string& args) {
-  ToolRun r;
   const std::string err_file =
       (aerie::test::binary_dir() / "test-scratch" / ("aerie-cmd." + std::to_string(::getpid()) + ".stderr")).string();
   std::filesystem::create_directories(aerie::test::binary_dir() / "test-scratch");
-  const std::string cmd = "'" + kTool + "' " + args + " 2>'" + err_file + "'";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (FILE* e = std::fopen(err_file.c_str(), "r")) {
-    while ((n = std::fread(buf.data(), 1, buf.size(), e)) > 0) r.err.append(buf.data(), n);
-    std::fclose(e);
-  }
+  const aerie::test::ToolRun t = aerie::test::run_tool("'" + kTool + "' " + args + " 2>'" + err_file + "'");
+  ToolRun r{t.rc, t.out, {}};
+  std::ifstream e(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(e), {});
   return r;
 }
 
