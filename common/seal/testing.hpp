@@ -23,4 +23,12 @@ struct RawHeader {
 std::vector<uint8_t> seal_plaintext(const SecretKey& mission_key, const RawHeader& header,
                                     std::span<const uint8_t> inner_plaintext);
 
+// A key of known bytes first, first + 1, ..., first + 31 (the fuzz targets' fixed keys: seeds
+// sealed with it open in every run).
+inline SecretKey counting_key(uint8_t first) {
+  std::array<uint8_t, SecretKey::kSize> b{};
+  for (size_t i = 0; i < b.size(); ++i) b[i] = static_cast<uint8_t>(first + i);
+  return SecretKey::from_bytes(b);
+}
+
 }  // namespace aerie::seal::for_tests

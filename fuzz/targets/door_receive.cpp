@@ -62,6 +62,7 @@
 
 #include "common/seal/operator.hpp"
 #include "common/seal/seal.hpp"
+#include "common/seal/testing.hpp"
 #include "tools/link/door.hpp"
 
 namespace {
@@ -69,11 +70,7 @@ namespace {
 using namespace aerie;
 
 const seal::SecretKey& test_key() {
-  static const seal::SecretKey key = [] {
-    std::vector<uint8_t> b(seal::SecretKey::kSize);
-    for (size_t i = 0; i < b.size(); ++i) b[i] = static_cast<uint8_t>(i);
-    return seal::SecretKey::from_bytes(b);
-  }();
+  static const seal::SecretKey key = seal::for_tests::counting_key(0);
   return key;
 }
 
@@ -81,11 +78,7 @@ constexpr seal::Direction kDir = seal::Direction::AirToGround;
 const char* const kCommands = "TRACK|FUZZ";  // mode 3: the operator's channels (inside kPolicy)
 
 const seal::OperatorKey& test_operator() {
-  static const seal::OperatorKey key = [] {
-    std::vector<uint8_t> b(seal::SecretKey::kSize);
-    for (size_t i = 0; i < b.size(); ++i) b[i] = static_cast<uint8_t>(32 + i);
-    return seal::OperatorKey::from_seed(seal::SecretKey::from_bytes(b));
-  }();
+  static const seal::OperatorKey key = seal::OperatorKey::from_seed(seal::for_tests::counting_key(32));
   return key;
 }
 seal::Session test_session() {

@@ -24,11 +24,7 @@ namespace {
 using namespace aerie;
 
 const seal::SecretKey& test_key() {
-  static const seal::SecretKey key = [] {
-    std::vector<uint8_t> b(seal::SecretKey::kSize);
-    for (size_t i = 0; i < b.size(); ++i) b[i] = static_cast<uint8_t>(i);
-    return seal::SecretKey::from_bytes(b);
-  }();
+  static const seal::SecretKey key = seal::for_tests::counting_key(0);
   return key;
 }
 
