@@ -22,13 +22,12 @@
 #include <map>
 #include <set>
 
-#include "air/pilot/pilot_config.hpp"
-#include "common/sim/flight/flight_config.hpp"
-#include "tools/landing/landing_run.hpp"
-#include "tools/link/sim_link.hpp"
+#include "tests/tools/door/split_landing.hpp"
 
 using namespace aerie;
 using seal::Refusal;
+using door_test::Message;
+using door_test::record;
 
 namespace {
 
@@ -41,45 +40,22 @@ Bytes encode(const T& m) {
   return b;
 }
 
-struct Message {
-  link::Side side;
-  std::string channel;
-  Bytes bytes;
-  bool operator==(const Message&) const = default;
-};
 
-// As test_door_landing's split, with the operator's commands also allowed up (as the secure
-// config/link.yaml carries them): the policy would let them cross, the seal is what refuses.
 // The operator's key of both flights (a run's signatures differ, what is published does not).
 std::shared_ptr<const seal::OperatorKey> operator_key() {
   static const auto key = std::make_shared<const seal::OperatorKey>(seal::OperatorKey::generate());
   return key;
 }
 
+// As test_door_landing's split, with the operator's commands also allowed up (as the secure
+// config/link.yaml carries them): the policy would let them cross, the seal is what refuses.
 landing::RunConfig landing_split(std::shared_ptr<const seal::SecretKey> key) {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = 2;
-  rc.sim.max_time_s = 60;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.track.tracker = "amcmr-ct";
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
-  link::Split split;
-  split.nodes = {{"track", link::Side::kGround}};
-  split.down.channels = "CAM_DOWN|GT_TRACK";
-  split.down.delay_ms = 20;
-  split.down.jitter_ms = 3;
-  split.down.seed = 3;
-  split.up.channels = "TRACK|TARGET_POSE|PILOT_CMD|TRACK_CMD|FLC_PARAMS|MAP_CMD";
-  split.up.name = "ground->air";
-  split.up.delay_ms = 20;
-  split.up.seed = 4;
+  landing::RunConfig rc = door_test::landing_split(2, "TRACK|TARGET_POSE|PILOT_CMD|TRACK_CMD|FLC_PARAMS|MAP_CMD");
   link::SimDoor door;
   door.key = std::move(key);  // default rekeying: one epoch for the flight, so each refusal's reason is exact
   door.operator_channels = link::kDefaultOperatorChannels;  // the operator signs, as aerie-link's halves
   door.operator_key = operator_key();
-  split.door = door;
-  rc.split = split;
+  rc.split->door = door;
   return rc;
 }
 
@@ -293,23 +269,6 @@ class Attacker {
   std::vector<Bytes> duplicate_;
 };
 
-// Every message on both buses; TRACK with its processing time (wall clock) zeroed.
-std::vector<Message> record(landing::RunConfig rc, landing::RunResult& result) {
-  std::vector<Message> out;
-  rc.on_message = [&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
-    Message m{side, channel, {data, data + size}};
-    if (channel == "TRACK") {
-      aerie::track_t t;
-      if (t.decode(data, 0, static_cast<int>(size)) > 0) {
-        t.processing_ms = 0;
-        m.bytes = encode(t);
-      }
-    }
-    out.push_back(std::move(m));
-  };
-  result = landing::fly(rc);
-  return out;
-}
 
 }  // namespace
 

@@ -8,12 +8,12 @@
 
 #include <cstring>
 
-#include "air/pilot/pilot_config.hpp"
-#include "common/sim/flight/flight_config.hpp"
-#include "tools/landing/landing_run.hpp"
-#include "tools/link/sim_link.hpp"
+#include "tests/tools/door/split_landing.hpp"
 
 using namespace aerie;
+using door_test::landing_split;
+using door_test::Message;
+using door_test::record;
 
 namespace {
 
@@ -28,53 +28,6 @@ link::SimDoor door_every_10s() {
   return d;
 }
 
-struct Message {
-  link::Side side;
-  std::string channel;
-  std::vector<uint8_t> bytes;
-  bool operator==(const Message&) const = default;
-};
-
-landing::RunConfig landing_split(uint64_t seed) {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = seed;
-  rc.sim.max_time_s = 60;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.track.tracker = "amcmr-ct";
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
-  link::Split split;
-  split.nodes = {{"track", link::Side::kGround}};  // images down, the tracker's results up
-  split.down.channels = "CAM_DOWN|GT_TRACK";
-  split.down.delay_ms = 20;
-  split.down.jitter_ms = 3;
-  split.down.seed = 3;
-  split.up.channels = "TRACK|TARGET_POSE";
-  split.up.name = "ground->air";
-  split.up.delay_ms = 20;
-  split.up.seed = 4;
-  rc.split = split;
-  return rc;
-}
-
-// Every message on both buses; TRACK with its processing time (wall clock) zeroed.
-std::vector<Message> record(landing::RunConfig rc, landing::RunResult& result) {
-  std::vector<Message> out;
-  rc.on_message = [&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
-    Message m{side, channel, {data, data + size}};
-    if (channel == "TRACK") {
-      aerie::track_t t;
-      if (t.decode(data, 0, static_cast<int>(size)) > 0) {
-        t.processing_ms = 0;
-        m.bytes.resize(static_cast<size_t>(t.getEncodedSize()));
-        t.encode(m.bytes.data(), 0, static_cast<int>(m.bytes.size()));
-      }
-    }
-    out.push_back(std::move(m));
-  };
-  result = landing::fly(rc);
-  return out;
-}
 
 }  // namespace
 
