@@ -40,7 +40,6 @@ Bytes encode(const T& m) {
   return b;
 }
 
-
 // The operator's key of both flights (a run's signatures differ, what is published does not).
 std::shared_ptr<const seal::OperatorKey> operator_key() {
   static const auto key = std::make_shared<const seal::OperatorKey>(seal::OperatorKey::generate());
