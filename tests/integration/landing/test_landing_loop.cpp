@@ -8,6 +8,7 @@
 
 #include "air/pilot/pilot_config.hpp"
 #include "common/sim/flight/flight_config.hpp"
+#include "tests/support/lockstep_bytes.hpp"
 #include "tools/landing/landing_run.hpp"
 
 using namespace aerie;
@@ -35,16 +36,7 @@ struct Message {
 std::vector<Message> record(landing::RunConfig rc, landing::RunResult* result = nullptr) {
   std::vector<Message> out;
   rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
-    Message m{channel, {data, data + size}};
-    if (channel == "TRACK") {
-      aerie::track_t t;
-      if (t.decode(data, 0, static_cast<int>(size)) > 0) {
-        t.processing_ms = 0;
-        m.bytes.resize(static_cast<size_t>(t.getEncodedSize()));
-        t.encode(m.bytes.data(), 0, static_cast<int>(m.bytes.size()));
-      }
-    }
-    out.push_back(std::move(m));
+    out.push_back(Message{channel, test::comparable_bytes(channel, data, size)});
   };
   const landing::RunResult r = landing::fly(rc);
   if (result) *result = r;
