@@ -131,7 +131,10 @@ ExitsScene::ExitsScene(const ExitsConfig& c) : ExitsScene(c, [&] {
     const int out = rng.uniform(c.out_frames_min, c.out_frames_max + 1);
     const bool elsewhere = rng.uniform(0.0, 1.0) < c.reenter_elsewhere;
     const double dir = rng.uniform(0, 2) ? 1.0 : -1.0;
-    cv::Point2d to(rng.uniform(0.3, 0.7) * W, rng.uniform(0.3, 0.7) * H);
+    // One draw per statement: a call's arguments are evaluated in an unspecified order (x86-64
+    // GCC right to left, arm64 left to right); this is x86's order, now on every architecture.
+    const double to_y = rng.uniform(0.3, 0.7) * H;
+    cv::Point2d to(rng.uniform(0.3, 0.7) * W, to_y);
     if (kind == 2) {
       // Occlusion, horizontal. The mast and the aircraft vibrate together, so only the
       // silhouette's circle (plus 1 px) matters: the aircraft waits where its crossing will be
@@ -194,7 +197,8 @@ ExitsScene::ExitsScene(const ExitsConfig& c) : ExitsScene(c, [&] {
     move(-d, r + margin + std::min(depth_in, 0.5 * extent - r - margin), speed, kind == 0);
     event = -1;
   }
-  wander(cv::Point2d(rng.uniform(0.3, 0.7) * W, rng.uniform(0.3, 0.7) * H), in_frames());
+  const double start_y = rng.uniform(0.3, 0.7) * H;  // one draw per statement (see above)
+  wander(cv::Point2d(rng.uniform(0.3, 0.7) * W, start_y), in_frames());
   // The first frame is the start of the first wander: fully in view by construction.
   return p;
 }()) {}

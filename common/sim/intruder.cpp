@@ -60,7 +60,10 @@ cv::RNG IntruderScene::build(const std::vector<IntruderPose>& path) {
   std::vector<cv::Point2d> jitter(cfg.frames);
   cv::Point2d j(0, 0);
   for (int k = 0; k < cfg.frames; ++k) {
-    j = 0.9 * j + cv::Point2d(rng.gaussian(cfg.vibration_px), rng.gaussian(cfg.vibration_px));
+    // One draw per statement: a call's arguments are evaluated in an unspecified order (x86-64
+    // GCC right to left, arm64 left to right); this is x86's order, now on every architecture.
+    const double jy = rng.gaussian(cfg.vibration_px);
+    j = 0.9 * j + cv::Point2d(rng.gaussian(cfg.vibration_px), jy);
     jitter[k] = j;
   }
   double max_jitter = 0;

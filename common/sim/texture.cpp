@@ -90,7 +90,10 @@ void scatter_marks(cv::Mat& img, double density, double per_m2, cv::RNG& rng, do
   const double sub = 1 << kShift;
   for (int i = 0; i < n; ++i) {
     const double size = density * std::exp(rng.uniform(std::log(0.01), std::log(0.12)));
-    const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), rng.uniform(0.0, 1.0 * img.rows));
+    // One draw per statement: a call's arguments are evaluated in an unspecified order (x86-64
+    // GCC right to left, arm64 left to right); this is x86's order, now on every architecture.
+    const double cy = rng.uniform(0.0, 1.0 * img.rows);
+    const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), cy);
     const float below = img.at<float>(std::min(static_cast<int>(c.y), img.rows - 1),
                                       std::min(static_cast<int>(c.x), img.cols - 1));
     // Dark on bright, bright on dark.
@@ -150,8 +153,8 @@ void draw_posters(cv::Mat& img, double density, cv::RNG& rng) {
   const int n = std::max(1, static_cast<int>(area / 2.5));
   for (int i = 0; i < n; ++i) {
     const int w = cvRound(rng.uniform(0.4, 1.3) * density), h = cvRound(rng.uniform(0.4, 1.0) * density);
-    const cv::Rect r(cvRound(rng.uniform(0.0, std::max(1.0, img.cols - 1.0 * w))),
-                     cvRound(rng.uniform(0.05, 0.5) * img.rows), w, h);
+    const int top = cvRound(rng.uniform(0.05, 0.5) * img.rows);  // one draw per statement (scatter_marks)
+    const cv::Rect r(cvRound(rng.uniform(0.0, std::max(1.0, img.cols - 1.0 * w))), top, w, h);
     const cv::Rect clip = r & cv::Rect(0, 0, img.cols, img.rows);
     if (clip.area() <= 0) continue;
     cv::Mat roi = img(clip);
@@ -160,7 +163,8 @@ void draw_posters(cv::Mat& img, double density, cv::RNG& rng) {
     const int items = rng.uniform(6, 20);
     for (int k = 0; k < items; ++k) {
       const cv::Scalar col(rng.uniform(0.0, 0.45));
-      const cv::Point p(rng.uniform(0, clip.width), rng.uniform(0, clip.height));
+      const int py = rng.uniform(0, clip.height);
+      const cv::Point p(rng.uniform(0, clip.width), py);
       if (kind == 0) {
         cv::circle(roi, p, rng.uniform(2, std::max(3, clip.width / 5)), col, cv::FILLED, cv::LINE_AA);
       } else if (kind == 1) {
@@ -219,8 +223,11 @@ void draw_planks(cv::Mat& img, double density, cv::RNG& rng, uint64_t seed) {
 void draw_panels(cv::Mat& img, double density, cv::RNG& rng) {
   for (double y = 0.5 * density; y < img.rows; y += 2.0 * density)
     for (double x = 0.5 * density; x < img.cols; x += 2.0 * density) {
-      const cv::Rect r(cvRound(x + rng.uniform(-0.3, 0.3) * density), cvRound(y + rng.uniform(-0.3, 0.3) * density),
-                       cvRound(rng.uniform(0.6, 1.2) * density), cvRound(rng.uniform(0.3, 0.6) * density));
+      // One draw per statement, the last argument first (scatter_marks).
+      const int h = cvRound(rng.uniform(0.3, 0.6) * density);
+      const int w = cvRound(rng.uniform(0.6, 1.2) * density);
+      const int top = cvRound(y + rng.uniform(-0.3, 0.3) * density);
+      const cv::Rect r(cvRound(x + rng.uniform(-0.3, 0.3) * density), top, w, h);
       const cv::Rect clip = r & cv::Rect(0, 0, img.cols, img.rows);
       if (clip.area() > 0) img(clip).setTo(cv::Scalar(rng.uniform(0.9, 1.0)));
     }
@@ -234,7 +241,8 @@ void draw_grass(cv::Mat& img, double density, cv::RNG& rng) {
   constexpr int kShift = 4;
   const double sub = 1 << kShift;
   for (int i = 0; i < n; ++i) {
-    const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), rng.uniform(0.0, 1.0 * img.rows));
+    const double cy = rng.uniform(0.0, 1.0 * img.rows);  // one draw per statement (scatter_marks)
+    const cv::Point2d c(rng.uniform(0.0, 1.0 * img.cols), cy);
     const double len = density * rng.uniform(0.015, 0.05), a = rng.uniform(0.0, CV_PI);
     const float below = img.at<float>(std::min(static_cast<int>(c.y), img.rows - 1),
                                       std::min(static_cast<int>(c.x), img.cols - 1));

@@ -217,8 +217,10 @@ void place_obstacles(std::vector<Obstacle>& obstacles, const Aabb& area, const s
     } else {
       size = {rng.uniform(0.4, 1.4), rng.uniform(0.4, 1.4), rng.uniform(0.4, 2.0)};
     }
-    const Eigen::Vector3d lo(rng.uniform(area.min.x(), area.max.x() - size.x()),
-                             rng.uniform(area.min.y(), area.max.y() - size.y()), 0.0);
+    // One draw per statement: a call's arguments are evaluated in an unspecified order (x86-64
+    // GCC right to left, arm64 left to right); this is x86's order, now on every architecture.
+    const double lo_y = rng.uniform(area.min.y(), area.max.y() - size.y());
+    const Eigen::Vector3d lo(rng.uniform(area.min.x(), area.max.x() - size.x()), lo_y, 0.0);
     o.box = {lo, lo + size};
     bool ok = true;
     for (const auto& p : keep_out)

@@ -250,7 +250,8 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   // Wind: steady part from a drawn direction, gusts from their stationary distribution.
   const double theta = 2 * kPi * u01(rng_);
   wind_mean_ = cfg_.wind.mean_m_s * Eigen::Vector3d(std::cos(theta), std::sin(theta), 0.0);
-  gust_ = cfg_.wind.gust_std() * Eigen::Vector3d(n01(rng_), n01(rng_), 0.0);
+  const double gust_y = n01(rng_), gust_x = n01(rng_);  // one draw per statement, as x86-64 GCC drew them
+  gust_ = cfg_.wind.gust_std() * Eigen::Vector3d(gust_x, gust_y, 0.0);
   for (auto& axis : vib_phase_) axis = {2 * kPi * u01(rng_), 2 * kPi * u01(rng_), 0.85, 1.15};
   yaw_gust_rng_.seed(mix_seed(cfg_.seed, 7007));
 }

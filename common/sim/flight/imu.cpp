@@ -22,7 +22,12 @@ Imu::Imu(const ImuParams& params, uint64_t seed) : p_(params), rng_(seed) {
   att_err_ = Eigen::Vector3d(p_.attitude_error_deg, p_.attitude_error_deg, p_.heading_error_deg).cwiseProduct(gauss3(kDeg));
 }
 
-Eigen::Vector3d Imu::gauss3(double sigma) { return sigma * Eigen::Vector3d(n01_(rng_), n01_(rng_), n01_(rng_)); }
+// One draw per statement: a call's arguments are evaluated in an unspecified order (x86-64
+// GCC right to left, arm64 left to right); this is x86's order, now on every architecture.
+Eigen::Vector3d Imu::gauss3(double sigma) {
+  const double z = n01_(rng_), y = n01_(rng_), x = n01_(rng_);
+  return sigma * Eigen::Vector3d(x, y, z);
+}
 
 ImuSample Imu::sample(double t, const Eigen::Quaterniond& q_wb, const Eigen::Vector3d& omega_body,
                       const Eigen::Vector3d& accel_world) {

@@ -97,7 +97,10 @@ void Multirotor::step(double t_s, double dt, const Eigen::Vector3d& wind, double
     ++command_timeouts_;
   }
   std::normal_distribution<double> n01(0.0, 1.0);
-  odometry_error_ += p_.hold_drift_m_per_sqrt_s * std::sqrt(dt) * Eigen::Vector2d(n01(rng_), n01(rng_));
+  // One draw per statement: a call's arguments are evaluated in an unspecified order (x86-64
+  // GCC right to left, arm64 left to right); this is x86's order, now on every architecture.
+  const double drift_y = n01(rng_), drift_x = n01(rng_);
+  odometry_error_ += p_.hold_drift_m_per_sqrt_s * std::sqrt(dt) * Eigen::Vector2d(drift_x, drift_y);
   using Mode = AutopilotCommand::Mode;
   if (active_.mode == Mode::Takeoff && !s_.armed) {
     s_.armed = true;
