@@ -12,6 +12,15 @@
 
 namespace aerie::capture {
 
+namespace {
+// The channel rule a config can break: split_stereo publishes the pair's images alone as well.
+void check_channels(const ChannelNames& ch, const std::string& where) {
+  if (ch.split_stereo && (ch.stereo.empty() || (ch.left.empty() && ch.right.empty())))
+    throw std::invalid_argument(where + ": channels.split_stereo: true needs channels.stereo and channels.left or "
+                                "channels.right (it publishes the stereo pair's images alone as well)");
+}
+}  // namespace
+
 CaptureConfig load_capture_config(const util::Config& c) {
   c.check_keys({"source.type", "source.path", "source.right", "source.calib", "source.timestamps",
                 "source.groundtruth", "source.fps", "sim.seed", "sim.trajectory", "sim.speed", "sim.loops",
@@ -19,7 +28,7 @@ CaptureConfig load_capture_config(const util::Config& c) {
                 "output.color", "output.encoding", "output.jpeg_quality", "playback.rate", "playback.start",
                 "playback.stop", "playback.duration", "playback.loop", "playback.stamp",
                 "playback.max_consecutive_errors", "channels.left", "channels.right", "channels.stereo",
-                "channels.mono", "channels.gt_pose", "channels.gt_track"});
+                "channels.mono", "channels.gt_pose", "channels.gt_track", "channels.split_stereo"});
   constexpr int64_t kMaxFrames = int64_t{1} << 40;
   CaptureConfig k;
   auto& s = k.source;
@@ -57,6 +66,8 @@ CaptureConfig load_capture_config(const util::Config& c) {
   ch.mono = c.get("channels.mono", ch.mono);
   ch.gt_pose = c.get("channels.gt_pose", ch.gt_pose);
   ch.gt_track = c.get("channels.gt_track", ch.gt_track);
+  ch.split_stereo = c.get("channels.split_stereo", ch.split_stereo);
+  check_channels(ch, c.origin());
   return k;
 }
 
@@ -75,8 +86,11 @@ FrameMessages MessageBuilder::build(const Frame& f, int64_t utime, int64_t seq) 
   };
   std::string image_channel;  // the channel GT_TRACK refers to
   if (stereo_) {
-    image_channel = ch.left;
-    const bool need_pair = !ch.left.empty() || !ch.right.empty() || (!ch.stereo.empty() && rectified_);
+    // Each image once: with CAM_STEREO, left and right alone only when asked (split_stereo).
+    const bool with_stereo = !ch.stereo.empty() && rectified_;
+    const bool alone = !with_stereo || ch.split_stereo;
+    image_channel = alone && !ch.left.empty() ? ch.left : with_stereo ? ch.stereo : ch.left;
+    const bool need_pair = (alone && (!ch.left.empty() || !ch.right.empty())) || with_stereo;
     if (need_pair) {
       m.left = image(f.left, "left");
       m.right = image(f.right, "right");
@@ -94,8 +108,8 @@ FrameMessages MessageBuilder::build(const Frame& f, int64_t utime, int64_t seq) 
       s.baseline_m = rectified_->baseline;
       m.stereo = std::move(s);
     }
-    if (ch.left.empty()) m.left.reset();
-    if (ch.right.empty()) m.right.reset();
+    if (ch.left.empty() || !alone) m.left.reset();
+    if (ch.right.empty() || !alone) m.right.reset();
   } else {
     image_channel = ch.mono;
     if (!ch.mono.empty()) m.mono = image(f.left, "mono");
@@ -142,8 +156,10 @@ CaptureNode::CaptureNode(bus::Bus& bus, const CaptureConfig& cfg, std::unique_pt
     throw std::invalid_argument("stamp must be 'source' or 'wall', got '" + cfg_.stamp + "'");
   if (cfg_.start < 0) throw std::invalid_argument("start frame must be >= 0");
   if (cfg_.stop >= 0 && cfg_.stop <= cfg_.start) throw std::invalid_argument("stop frame must be after the start frame");
-  if (source_->stereo() && !source_->rectified() && !cfg_.channels.stereo.empty())
-    spdlog::warn("{}: no stereo calibration, so no {} (only the raw pair)", source_->describe(), cfg_.channels.stereo);
+  const auto& ch = cfg_.channels;
+  if (source_->stereo() && !source_->rectified() && !ch.stereo.empty())
+    spdlog::warn("{}: no stereo calibration, so no {} (only the raw pair)", source_->describe(), ch.stereo);
+  check_channels(ch, "aerie-capture");
 }
 
 void CaptureNode::publish(const FrameMessages& m) {

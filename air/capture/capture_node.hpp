@@ -1,7 +1,9 @@
 #pragma once
 // The aerie-capture node: plays a FrameSource onto LCM.
-//   stereo source -> CAM_LEFT, CAM_RIGHT (aerie.image_t, rectified) and CAM_STEREO
-//                    (aerie.stereo_image_t with the rectified intrinsics and baseline)
+//   stereo source -> CAM_STEREO (aerie.stereo_image_t: the rectified pair, its intrinsics and
+//                    baseline); CAM_LEFT, CAM_RIGHT (aerie.image_t) only when split_stereo is
+//                    set or there is no CAM_STEREO (no calibration, or the channel turned off),
+//                    so that each image is on the wire (and in the log) once
 //   one camera    -> CAM_MONO
 //   ground truth  -> GT_POSE (aerie.gt_pose_t), GT_TRACK (aerie.gt_box_t)
 // All messages of one frame share its utime and seq. An empty channel name turns
@@ -32,6 +34,9 @@ struct ChannelNames {
   std::string mono = channels::kCamMono;
   std::string gt_pose = channels::kGtPose;
   std::string gt_track = channels::kGtTrack;
+  // A source whose rectified pair goes out on `stereo` also publishes its images alone on
+  // `left` / `right` (each image then twice on the wire).
+  bool split_stereo = false;
 };
 
 struct CaptureConfig {

@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
   option(app, ov, "--left-channel", [](CaptureConfig& c) -> auto& { return c.channels.left; }, "\"\" turns it off");
   option(app, ov, "--right-channel", [](CaptureConfig& c) -> auto& { return c.channels.right; }, "\"\" turns it off");
   option(app, ov, "--stereo-channel", [](CaptureConfig& c) -> auto& { return c.channels.stereo; }, "\"\" turns it off");
+  app.add_flag_callback(
+      "--split-stereo", [&ov] { ov.push_back([](CaptureConfig& c) { c.channels.split_stereo = true; }); },
+      "with CAM_STEREO, also publish the left and right images alone (each image twice on the wire)");
   option(app, ov, "--mono-channel", [](CaptureConfig& c) -> auto& { return c.channels.mono; }, "\"\" turns it off");
   option(app, ov, "--gt-pose-channel", [](CaptureConfig& c) -> auto& { return c.channels.gt_pose; }, "\"\" turns it off");
   option(app, ov, "--gt-track-channel", [](CaptureConfig& c) -> auto& { return c.channels.gt_track; }, "\"\" turns it off");

@@ -15,8 +15,18 @@ void Subscription::on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& cha
   { std::lock_guard<std::mutex> hand_off(bus_->hand_off_); }  // after the publish that queued rbuf (bus.hpp)
 #endif
   ++counters_.received;
+  guarded(channel, [&] { dispatch(rbuf, channel); });
+}
+
+bool Subscription::deliver_one() {
+  bool delivered = false;
+  guarded(channel_, [&] { delivered = deliver_next(); });
+  return delivered;
+}
+
+void Subscription::guarded(const std::string& channel, const std::function<void()>& f) {
   try {
-    dispatch(rbuf, channel);
+    f();
   } catch (const std::invalid_argument& e) {
     ++counters_.malformed;
     last_error_ = channel + ": " + e.what();
@@ -89,10 +99,29 @@ void Bus::publish_raw(const std::string& channel, const void* data, size_t size)
     ++publish_errors_;
 }
 
-int Bus::handle(int timeout_ms) {
+int Bus::handle_lcm(int timeout_ms) {
   const int r = lcm_.handleTimeout(timeout_ms);
   if (r < 0 && errno != EINTR) throw std::runtime_error("LCM handle failed on " + url_);
   return r < 0 ? 0 : r;
+}
+
+int Bus::handle(int timeout_ms) {
+  const bool any_queued = std::any_of(subs_.begin(), subs_.end(), [](const auto& s) { return s->queue_capacity() > 0; });
+  if (!any_queued) return handle_lcm(timeout_ms);
+  const auto waiting = [&] {
+    return std::any_of(subs_.begin(), subs_.end(), [](const auto& s) { return s->queued() > 0; });
+  };
+  // Everything LCM holds now (each message is handled or queued at once), waiting for one
+  // message only when nothing is queued. Bounded: a publisher faster than the decoder must
+  // not keep the queued handlers from running.
+  int handled = handle_lcm(waiting() ? 0 : timeout_ms);
+  for (int i = 0, n = handled; n > 0 && i < 10 * kLcmSpill; ++i) handled += n = handle_lcm(0);
+  // One queued message, taking the subscriptions in turn.
+  for (size_t k = 0; k < subs_.size(); ++k) {
+    next_queued_ = (next_queued_ + 1) % subs_.size();
+    if (subs_[next_queued_]->deliver_one()) return handled + 1;
+  }
+  return handled;
 }
 
 }  // namespace aerie::bus

@@ -3,11 +3,16 @@
 // A subscription decodes the message itself, bounded (wire.hpp), so a corrupt or hostile
 // payload is counted and logged instead of reaching the handler; a handler that throws is counted too.
 // Gaps in `seq` are counted as drops (LCM drops silently when a queue is full).
+// A queued subscription (subscribe_queued) takes every message off LCM at once into a bounded
+// queue of its own that counts what it discards (queue_overflows), so its sequence gaps are
+// upstream losses only (docs/stereo.md, "Keeping up on a small board").
 #include <lcm/lcm-cpp.hpp>
 
 #include <atomic>
+#include <algorithm>
 #include <concepts>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -38,6 +43,13 @@ struct ChannelCounters {
   std::atomic<int64_t> malformed{0};        // failed to decode
   std::atomic<int64_t> handler_errors{0};   // handler threw
   std::atomic<int64_t> sequence_gaps{0};    // messages missing according to seq
+  std::atomic<int64_t> queue_overflows{0};  // queued subscription: discarded because its queue was full
+};
+
+// Which message a full queue of a queued subscription discards.
+enum class Overflow {
+  kDropOldest,  // keep the latest (a camera: work on the newest frame)
+  kDropNewest,  // keep the first ones (as LCM's own queue)
 };
 
 struct ReceiveInfo {
@@ -52,11 +64,19 @@ class Subscription {
   const std::string& channel() const { return channel_; }
   const ChannelCounters& counters() const { return counters_; }
   const std::string& last_error() const { return last_error_; }
+  // Queued subscriptions: capacity of the own queue (0 = none, LCM's queue only) and messages waiting in it.
+  size_t queue_capacity() const { return queue_capacity_; }
+  virtual size_t queued() const { return 0; }
 
  protected:
   friend class Bus;
   void on_raw(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   virtual void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) = 0;
+  // Queued subscriptions: hands the oldest waiting message to the handler (false: none waits).
+  bool deliver_one();
+  virtual bool deliver_next() { return false; }
+  // Runs f, counting (and logging) a malformed message or a handler that threw.
+  void guarded(const std::string& channel, const std::function<void()>& f);
   // Sequence gaps are counted per channel: a pattern subscription (STATUS_.*) hears several
   // publishers, each with its own seq. At most kSeqChannels channels are followed.
   void note_seq(const std::string& channel, int64_t seq);
@@ -68,6 +88,7 @@ class Subscription {
   std::map<std::string, int64_t> last_seq_;  // per channel heard
   lcm::Subscription* handle_ = nullptr;
   Bus* bus_ = nullptr;
+  size_t queue_capacity_ = 0;
 };
 
 template <typename Msg>
@@ -79,15 +100,36 @@ template <typename Msg>
 class TypedSubscription final : public Subscription {
  public:
   using Handler = std::function<void(const Msg&, const ReceiveInfo&)>;
-  explicit TypedSubscription(Handler h) : handler_(std::move(h)) {}
+  explicit TypedSubscription(Handler h, size_t queue_capacity = 0, Overflow overflow = Overflow::kDropOldest)
+      : handler_(std::move(h)), overflow_(overflow) {
+    queue_capacity_ = queue_capacity;
+  }
+  size_t queued() const override { return queue_.size(); }
 
  private:
   void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel) override {
-    const Msg msg = decode_bounded<Msg>(rbuf->data, rbuf->data_size);  // throws std::invalid_argument
+    Msg msg = decode_bounded<Msg>(rbuf->data, rbuf->data_size);  // throws std::invalid_argument
+    // Before the own queue: a gap is a message that never reached this subscription.
     if constexpr (HasSeq<Msg>) note_seq(channel, msg.seq);
-    handler_(msg, ReceiveInfo{channel, rbuf->recv_utime, rbuf->data_size});
+    ReceiveInfo info{channel, rbuf->recv_utime, rbuf->data_size};
+    if (queue_capacity_ == 0) return handler_(msg, info);
+    if (queue_.size() >= queue_capacity_) {
+      ++counters_.queue_overflows;
+      if (overflow_ == Overflow::kDropNewest) return;
+      queue_.pop_front();
+    }
+    queue_.emplace_back(std::move(msg), std::move(info));
+  }
+  bool deliver_next() override {
+    if (queue_.empty()) return false;
+    auto [msg, info] = std::move(queue_.front());
+    queue_.pop_front();
+    handler_(msg, info);
+    return true;
   }
   Handler handler_;
+  Overflow overflow_;
+  std::deque<std::pair<Msg, ReceiveInfo>> queue_;
 };
 
 // Undecoded messages (any type), e.g. for relays, loggers and latency measurement.
@@ -132,6 +174,22 @@ class Bus {
     return attach(std::move(sub), channel, queue_capacity);
   }
 
+  // A subscription with a bounded queue of its own: handle() first takes every message LCM
+  // holds (decoded and queued, `overflow` deciding what a full queue discards, each one
+  // counted in queue_overflows), then hands queued messages to the handler, oldest first,
+  // one per handle() call, between LCM's. LCM's queue behind it holds kLcmSpill messages
+  // (it only fills while one handler runs for longer than kLcmSpill messages take to come;
+  // what it drops then shows as sequence gaps). capacity >= 1.
+  static constexpr int kLcmSpill = 100;
+  template <typename Msg>
+  Subscription& subscribe_queued(const std::string& channel, typename TypedSubscription<Msg>::Handler handler,
+                                 size_t capacity, Overflow overflow = Overflow::kDropOldest) {
+    if (capacity < 1) throw std::invalid_argument("subscribe_queued: " + channel + ": queue capacity must be >= 1");
+    auto sub = std::make_unique<TypedSubscription<Msg>>(std::move(handler), capacity, overflow);
+    const int lcm_capacity = static_cast<int>(std::max<size_t>(capacity, kLcmSpill));
+    return attach(std::move(sub), channel, lcm_capacity);
+  }
+
   // channel_regex is an LCM channel regular expression (e.g. "CAM_.*").
   Subscription& subscribe_raw(const std::string& channel_regex, RawSubscription::Handler handler,
                               int queue_capacity = 30) {
@@ -143,6 +201,8 @@ class Bus {
   void unsubscribe(const Subscription& sub);
 
   // Handles messages for up to timeout_ms; returns how many were handled (0 on timeout).
+  // With queued subscriptions, one call takes everything LCM holds and then hands one queued
+  // message on (waiting only when none is queued); the count includes both.
   int handle(int timeout_ms);
   int fileno() { return lcm_.getFileno(); }
   const std::string& url() const { return url_; }
@@ -152,6 +212,7 @@ class Bus {
  private:
   friend class Subscription;
   Subscription& attach(std::unique_ptr<Subscription> sub, const std::string& channel, int queue_capacity);
+  int handle_lcm(int timeout_ms);
 
   // ThreadSanitizer cannot see the GLib mutex (a raw futex) with which liblcm's memq://
   // hands a published buffer to the thread that handles it, and reports our decoder's read
@@ -173,6 +234,7 @@ class Bus {
   std::string url_;
   lcm::LCM lcm_;
   std::vector<std::unique_ptr<Subscription>> subs_;
+  size_t next_queued_ = 0;  // the queued subscription handle() served last
   std::atomic<int64_t> publish_errors_{0};
 };
 

@@ -55,6 +55,11 @@ class Node {
                           int queue_capacity = 30) {
     return own(bus_.subscribe<Msg>(channel, std::move(handler), queue_capacity));
   }
+  template <typename Msg>
+  Subscription& subscribe_queued(const std::string& channel, typename TypedSubscription<Msg>::Handler handler,
+                                 size_t capacity, Overflow overflow = Overflow::kDropOldest) {
+    return own(bus_.subscribe_queued<Msg>(channel, std::move(handler), capacity, overflow));
+  }
   Subscription& subscribe_raw(const std::string& channel_regex, RawSubscription::Handler handler,
                               int queue_capacity = 30) {
     return own(bus_.subscribe_raw(channel_regex, std::move(handler), queue_capacity));

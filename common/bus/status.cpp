@@ -75,6 +75,10 @@ void StatusReporter::publish_now() {
     add(sub->channel() + ".malformed", c.malformed);
     add(sub->channel() + ".handler_errors", c.handler_errors);
     add(sub->channel() + ".sequence_gaps", c.sequence_gaps);
+    if (sub->queue_capacity() > 0) {  // a queue of its own (subscribe_queued): what it discarded, what waits
+      add(sub->channel() + ".queue_overflows", c.queue_overflows);
+      add(sub->channel() + ".queued", static_cast<int64_t>(sub->queued()));
+    }
   }
   add("publish_errors", bus_.publish_errors());
   m.ncounters = static_cast<int32_t>(m.counter_names.size());

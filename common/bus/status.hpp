@@ -1,7 +1,8 @@
 #pragma once
 // A node's heartbeat: named cumulative counters and per-period timings, published
 // as aerie.process_status_t on STATUS_<NODE> about once a second. Counters of every
-// subscription on the bus (received, malformed, gaps, handler errors) are included.
+// subscription on the bus (received, malformed, gaps, handler errors; a queued one adds
+// queue_overflows and queued) are included.
 #include <aerie/process_status_t.hpp>
 
 #include <cstdint>

@@ -60,8 +60,8 @@ Payloads expected_messages(capture::FrameSource& src, const capture::CaptureConf
   for (int i = 0; i < frames && src.next(f); ++i) {
     fmt.apply(f);
     const auto m = builder.build(f, f.utime, i);
-    p["CAM_LEFT"].push_back(encode(*m.left));
-    p["CAM_RIGHT"].push_back(encode(*m.right));
+    if (m.left) p["CAM_LEFT"].push_back(encode(*m.left));  // only with channels.split_stereo (issue 49)
+    if (m.right) p["CAM_RIGHT"].push_back(encode(*m.right));
     p["CAM_STEREO"].push_back(encode(*m.stereo));
     if (m.gt_pose) p["GT_POSE"].push_back(encode(*m.gt_pose));
     if (m.gt_box) p["GT_TRACK"].push_back(encode(*m.gt_box));

@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-ba", no_ba, "run without the keyframe bundle adjustment");
   app.add_flag("--replay", replay,
                "replaying a log: process every pair, whatever the speed (the input queue 1000 pairs instead of "
-               "node.queue); with ba.apply next_keyframe (the default) a replay gives the live poses again");
+               "node.queue; still, every pair dropped is counted); with ba.apply next_keyframe (the default) a replay gives the live poses again");
   CLI11_PARSE(app, argc, argv);
   aerie::util::init_logging("vo", common.log_level);
   // The front end is one thread by design (the bundle adjuster has its own): OpenCV's pool
@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
       node.tick();  // reports the camera stale during an outage
       return true;
     });
-    spdlog::info("stopped after {} stereo pairs ({} refused)", node.processed(), node.refused());
+    spdlog::info("stopped after {} stereo pairs ({} refused); {}: {} dropped here (input queue of {} full), {} missing "
+                 "upstream (sequence gaps)",
+                 node.processed(), node.refused(), cfg.input, node.queue_overflows(), cfg.queue, node.upstream_gaps());
     return 0;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

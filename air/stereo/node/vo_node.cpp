@@ -35,12 +35,41 @@ VoNodeConfig load_vo_node_config(const util::Config& cfg) {
 }
 
 VoNode::VoNode(bus::Bus& bus, bus::StatusReporter& status, const VoNodeConfig& cfg, util::NodeClock now)
-    : bus_(bus), status_(status), cfg_(cfg), now_(std::move(now)), camera_clock_(status, cfg.input, cfg.message_time) {
+    : bus_(bus),
+      status_(status),
+      cfg_(cfg),
+      now_(std::move(now)),
+      camera_clock_(status, cfg.input, cfg.message_time),
+      input_(bus_.subscribe_queued<aerie::stereo_image_t>(
+          cfg_.input,
+          [this](const aerie::stereo_image_t& m, const bus::ReceiveInfo& info) { on_stereo(m, info.recv_utime); },
+          static_cast<size_t>(std::max(cfg_.queue, 1)))) {
   cfg_.vo.validate();
-  bus_.subscribe<aerie::stereo_image_t>(
-      cfg_.input, [this](const aerie::stereo_image_t& m, const bus::ReceiveInfo& info) { on_stereo(m, info.recv_utime); },
-      cfg_.queue);
   status_.ok("waiting for " + cfg_.input);
+}
+
+void VoNode::tick() {
+  camera_clock_.check(now_());
+  if (queue_overflows() > reported_overflows_) report(status_.message());
+}
+
+void VoNode::report(const std::string& state) {
+  const int64_t overflows = queue_overflows(), gaps = upstream_gaps();
+  if (overflows == 0 && gaps == 0) return status_.ok(state);
+  // The state without a previous report's suffix (tick() re-reports the last message).
+  const std::string base = state.substr(0, state.find(" | "));
+  const std::string losses = base + " | " + cfg_.input + ": " + std::to_string(overflows) +
+                             " pairs dropped here (input queue of " + std::to_string(cfg_.queue) +
+                             " full: the odometry is slower than the camera), " + std::to_string(gaps) +
+                             " missing upstream (sequence gaps)";
+  const int64_t now = now_();
+  if (overflows > reported_overflows_) {
+    reported_overflows_ = overflows;
+    last_overflow_us_ = now;
+  }
+  // WARN while pairs are being dropped (one within the last 2 s), OK with the totals after.
+  if (overflows > 0 && now - last_overflow_us_ < 2'000'000) return status_.warn(losses);
+  status_.ok(losses);
 }
 
 VoNode::~VoNode() = default;
@@ -193,7 +222,7 @@ void VoNode::publish(const VoResult& r, int64_t seq, int64_t receive_utime) {
     status_.count("resets");
     spdlog::info("frame {}: {}", r.frame, r.message);
   } else {
-    status_.ok(to_string(r.status));
+    report(to_string(r.status));
   }
   status_.set("features", r.features);
   status_.set("matches", r.matches);

@@ -25,6 +25,9 @@ struct VoNodeConfig {
   int64_t max_pair_skew_us = 1000;
   double spherical_resolution_deg = 0.5;
   double spherical_max_range_m = 20.0;
+  // Pairs waiting for the odometry in the node's own input queue (bus::subscribe_queued): when
+  // it is full the oldest waiting pair is dropped (the odometry works on the newest) and counted
+  // as <input>.queue_overflows, apart from <input>.sequence_gaps (pairs that never arrived).
   int queue = 4;
   // message_time.*: the camera's time (docs/architecture.md "Message time"): jumps are held,
   // a restart / outage re-synchronises (and restarts the odometry from the last pose), no pair
@@ -44,10 +47,14 @@ class VoNode {
   // are logged and counted.
   void on_stereo(const aerie::stereo_image_t& msg, int64_t receive_utime);
 
-  // Reports the camera stale when no pair came for message_time.stale_timeout_s.
-  void tick() { camera_clock_.check(now_()); }
+  // Reports the camera stale when no pair came for message_time.stale_timeout_s, and pairs
+  // dropped from the input queue since the last pair was published.
+  void tick();
 
   int64_t processed() const { return processed_; }
+  // Pairs dropped here because the input queue was full, and pairs missing upstream (seq gaps).
+  int64_t queue_overflows() const { return input_.counters().queue_overflows; }
+  int64_t upstream_gaps() const { return input_.counters().sequence_gaps; }
   int64_t refused() const { return refused_; }
   const std::optional<VoResult>& last() const { return last_; }
 
@@ -55,12 +62,16 @@ class VoNode {
   // Throws std::invalid_argument with the reason when the pair cannot be used.
   void check(const aerie::stereo_image_t& msg) const;
   void publish(const VoResult& r, int64_t seq, int64_t receive_utime);
+  // status_.ok(state), naming the input's losses; WARN for a while after a pair was dropped here.
+  void report(const std::string& state);
 
   bus::Bus& bus_;
   bus::StatusReporter& status_;
   VoNodeConfig cfg_;
   util::NodeClock now_;
   bus::InputClock camera_clock_;
+  bus::Subscription& input_;
+  int64_t reported_overflows_ = 0, last_overflow_us_ = 0;
   std::unique_ptr<StereoOdometry> vo_;
   std::unique_ptr<spherical::SphericalEncoder> encoder_;
   int64_t last_utime_ = -1;

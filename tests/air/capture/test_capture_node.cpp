@@ -31,6 +31,7 @@ Frame stereo_frame() {
 
 TEST(MessageBuilder, StereoFrameGivesPairStereoAndGroundTruth) {
   CaptureConfig cfg;
+  cfg.channels.split_stereo = true;  // the images alone too (the default publishes each image once: CAM_STEREO)
   const camera::RectifiedStereo r{100, 101, 15.5, 11.5, 0.12, {32, 24}};
   MessageBuilder b(cfg, true, r);
   const auto m = b.build(stereo_frame(), 2'000'000, 17);
@@ -56,6 +57,7 @@ TEST(MessageBuilder, StereoFrameGivesPairStereoAndGroundTruth) {
 
 TEST(MessageBuilder, ChannelsTurnedOffAndJpeg) {
   CaptureConfig cfg;
+  cfg.channels.split_stereo = true;  // the right image alone as well
   cfg.channels.left = "";
   cfg.channels.gt_track = "";
   cfg.encoding = "jpeg";
@@ -161,6 +163,7 @@ TEST(CaptureNode, KittiOverMemqWithStartStopAndDownscale) {
   cfg.start = 10;
   cfg.stop = 16;
   cfg.output.downscale = 2;
+  cfg.channels.split_stereo = true;  // CAM_LEFT / CAM_RIGHT as well
   CaptureNode node(bus, cfg, std::make_unique<StereoSequenceSource>(load_kitti(dir.string()), false));
   const auto st = node.run();
   while (bus.handle(0) > 0) {
