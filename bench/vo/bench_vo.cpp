@@ -3,6 +3,9 @@
 // (ATE after SE3 alignment, RPE per frame and over segments, per-axis RMSE, end-point
 // drift, printed only for a loop: eval::is_loop), with the thread CPU time of every stage.
 // Ground truth comes from the dataset's own layout (eval::kGroundTruthLayouts) or --groundtruth.
+// --mono also runs the monocular VO (air/mono) on the left images of the same frames, scored
+// after Sim(3) alignment (its scale is arbitrary) from the frame its first map was made, and
+// prints both in one table (docs/results/stereo.md, "Monocular VO").
 #include <CLI/CLI.hpp>
 #include <opencv2/core/utility.hpp>
 
@@ -14,6 +17,7 @@
 #include <memory>
 #include <sstream>
 
+#include "air/mono/mono_config.hpp"
 #include "air/stereo/cpu_time.hpp"
 #include "air/stereo/vo/vo_config.hpp"
 #include "common/sim/simulation.hpp"
@@ -116,7 +120,8 @@ int main(int argc, char** argv) {
   std::string dataset, groundtruth, config, out = "vo_trajectory.txt", json_path, plot;
   size_t max_frames = 0;
   double rpe_delta_m = 0;
-  bool ba_sync = true, exact_depth = false;
+  bool ba_sync = true, exact_depth = false, with_mono = false;
+  std::string mono_config, mono_out = "mono_trajectory.txt";
   app.add_option("--dataset", dataset, "kitti:DIR, euroc:DIR or sim:CONFIG.yaml")->required();
   app.add_option("--groundtruth", groundtruth,
                  std::string("ground truth instead of the folder's own, format detected from the content: ") +
@@ -132,6 +137,10 @@ int main(int argc, char** argv) {
   app.add_option("--ba-sync", ba_sync, "wait for each bundle adjustment (reproducible figures; false = as flown)");
   app.add_flag("--exact-depth", exact_depth, "sim only: use the renderer's exact disparity instead of SGBM_F "
                                           "(separates depth errors from tracking errors)");
+  app.add_flag("--mono", with_mono, "also run the monocular VO on the left images (scored after Sim(3) alignment)");
+  app.add_option("--mono-config", mono_config, "monocular VO configuration (config/mono.yaml format)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--mono-out", mono_out, "monocular trajectory output (TUM), from its first map on");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -148,6 +157,18 @@ int main(int argc, char** argv) {
     Source src = open_dataset(dataset, groundtruth, exact_depth);
     if (exact_depth && dataset.rfind("sim:", 0) != 0) throw std::runtime_error("--exact-depth needs a sim: dataset");
     stereo::StereoOdometry vo(src.cam, params);
+    mono::MonoParams mono_params = mono_config.empty() ? mono::MonoParams{}
+                                                       : mono::mono_params_from_config(util::Config::load(mono_config),
+                                                                                       mono::kMonoNodeSections);
+    mono_params.ba_synchronous = ba_sync;
+    std::unique_ptr<mono::MonoOdometry> mvo;
+    if (with_mono)
+      mvo = std::make_unique<mono::MonoOdometry>(
+          mono::PinholeCamera{src.cam.fx, src.cam.fy, src.cam.cx, src.cam.cy, src.cam.width, src.cam.height}, mono_params);
+    eval::Trajectory mono_est;
+    int mono_first = -1, mono_lost = 0, mono_resets = 0, mono_keyframes = 0;
+    double mono_front_ms = 0, mono_process_ms = 0;
+    std::string mono_init;
     std::cout << src.name << ": " << src.frames << " frames " << src.cam.width << "x" << src.cam.height
               << ", f " << src.cam.fx << " px, baseline " << src.cam.baseline << " m, SGM SIMD "
               << stereo::SemiGlobalMatcher::simd_target() << "\n";
@@ -185,7 +206,27 @@ int main(int argc, char** argv) {
       inlier_ratio += res.inlier_ratio;
       if (res.status == stereo::VoStatus::Lost || res.status == stereo::VoStatus::Reset)
         std::cout << "frame " << res.frame << ": " << stereo::to_string(res.status) << " - " << res.message << "\n";
+      if (mvo) {
+        // The monocular VO on the left image; with --ba-sync its BA runs inside the call, so
+        // the process CPU of the call is the whole node's.
+        const double mp0 = stereo::process_cpu_ms(), mt0 = stereo::cpu_ms();
+        const mono::MonoResult mr = mvo->process(l, utime);
+        mono_process_ms += stereo::process_cpu_ms() - mp0;
+        mono_front_ms += stereo::cpu_ms() - mt0;
+        if (mono_first < 0 && mr.status != mono::MonoStatus::Initialising && mr.status != mono::MonoStatus::Lost) {
+          mono_first = static_cast<int>(i);
+          mono_init = mr.message;
+        }
+        if (mono_first >= 0) mono_est.push_back(static_cast<double>(utime) * 1e-6, mr.T_world_cam);
+        mono_lost += mr.status == mono::MonoStatus::Lost;
+        mono_resets += mr.status == mono::MonoStatus::Reset;
+        mono_keyframes += mr.keyframe;
+        if (mr.status == mono::MonoStatus::Lost || mr.status == mono::MonoStatus::Reset)
+          std::cout << "mono frame " << mr.frame << ": " << mono::to_string(mr.status) << " - " << mr.message << "\n";
+        if (i + 1 == src.frames && mono_first < 0) mono_init = mr.message;
+      }
     }
+    if (mvo) mvo->flush();
     const double p0 = stereo::process_cpu_ms(), t0 = stereo::cpu_ms();
     vo.flush();
     process_ms += stereo::process_cpu_ms() - p0;
@@ -221,6 +262,38 @@ int main(int argc, char** argv) {
       const eval::Report rep = eval::evaluate(*src.gt, est, ro);
       eval::print(std::cout, rep, ro);
       js << ", \"metrics\": " << eval::to_json(rep, ro);
+      if (mvo) {
+        // One table: the stereo VO (SE3 alignment) and the monocular one (Sim(3), from its first map).
+        std::cout << "\n| sequence | VO | frames scored | ATE RMSE m | RPE % | RPE deg/frame | front end ms/frame | "
+                     "with BA ms/frame |\n|---|---|---|---|---|---|---|---|\n"
+                  << "| " << src.name << " | stereo (SE3) | " << rep.matched << " | " << std::setprecision(3)
+                  << rep.ate.rmse << " | " << rep.rpe_trans_percent << " | " << rep.rpe_rot.rmse << " | "
+                  << thread_ms / std::max(1, n) << " | " << process_ms / std::max(1, n) << " |\n";
+        js << ", \"mono\": {\"first_frame\": " << mono_first << ", \"lost\": " << mono_lost
+           << ", \"resets\": " << mono_resets << ", \"keyframes\": " << mono_keyframes
+           << ", \"ms_front_end\": " << mono_front_ms / std::max(1, n)
+           << ", \"ms_with_ba\": " << mono_process_ms / std::max(1, n);
+        if (mono_est.size() >= 3) {
+          // Sim(3) first (Umeyama with scale), then every metric on the scaled estimate: the
+          // RPE of an unscaled monocular trajectory would measure its arbitrary scale.
+          const auto a = eval::associate(*src.gt, mono_est, ro.max_dt);
+          eval::Similarity sim3;
+          const eval::Trajectory scaled = eval::align(a.est, a.ref, eval::Alignment::Sim3, &sim3);
+          const eval::Report mrep = eval::evaluate(a.ref, scaled, ro);  // SE3 on top: the identity
+          js << ", \"sim3_scale\": " << sim3.scale;
+          std::cout << "| " << src.name << " | mono (Sim3, scale " << sim3.scale << ") | " << mrep.matched
+                    << " | " << mrep.ate.rmse << " | " << mrep.rpe_trans_percent << " | " << mrep.rpe_rot.rmse << " | "
+                    << mono_front_ms / std::max(1, n) << " | " << mono_process_ms / std::max(1, n) << " |\n";
+          js << ", \"metrics\": " << eval::to_json(mrep, ro);
+        } else {
+          std::cout << "| " << src.name << " | mono | 0 (not initialised) | - | - | - | " << mono_front_ms / std::max(1, n)
+                    << " | " << mono_process_ms / std::max(1, n) << " |\n";
+        }
+        js << "}";
+        std::cout << std::setprecision(2) << "mono: first map at frame " << mono_first << " (" << mono_init << "), "
+                  << mono_keyframes << " keyframes, " << mono_lost << " lost, " << mono_resets << " resets\n";
+        eval::write_tum(mono_est, mono_out);
+      }
       if (!plot.empty()) {
         // Aligned estimate and ground truth for the plot script.
         const auto a = eval::associate(*src.gt, est, ro.max_dt);
