@@ -25,8 +25,9 @@ std::string fmt(double v, int prec = 3) {
 
 Outcome refuse(std::string why) { return {false, std::move(why)}; }
 
-// The sample at time t inside [a, b]: linear interpolation, or a held (when the step is a gap).
-ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t, bool hold) {
+}  // namespace
+
+ImuSample interpolate_imu(const ImuSample& a, const ImuSample& b, int64_t t, bool hold) {
   ImuSample c = a;
   c.utime = t;
   if (!hold) {
@@ -36,8 +37,6 @@ ImuSample interpolate(const ImuSample& a, const ImuSample& b, int64_t t, bool ho
   }
   return c;
 }
-
-}  // namespace
 
 const char* to_string(NavStatus s) {
   switch (s) {
@@ -89,38 +88,46 @@ Eskf::Eskf(EskfParams params) : p_(std::move(params)) { p_.validate(); }
 // ---------------------------------------------------------------------------------------------
 // IMU
 
-Outcome Eskf::add_imu(const ImuSample& s) {
+Outcome check_imu(const EskfParams& p, const ImuSample& s, std::optional<int64_t> prev, bool aligned,
+                  EskfCounters& counters) {
   // Message time is microseconds since an epoch: never negative. Refusing it keeps every
   // difference of two accepted times inside int64 (a first sample at INT64_MIN made the next
   // gap overflow: the nav fuzzer).
   if (s.utime < 0) {
-    ++counters_.imu_negative_time;
+    ++counters.imu_negative_time;
     return refuse("IMU sample at utime " + utime_str(s.utime) + ": negative time");
   }
   if (!s.gyro.allFinite() || !s.accel.allFinite()) {
-    ++counters_.imu_non_finite;
+    ++counters.imu_non_finite;
     return refuse("IMU sample at utime " + utime_str(s.utime) + ": non-finite gyro or accel (NaN/Inf)");
   }
-  if (s.gyro.cwiseAbs().maxCoeff() > p_.max_gyro_rad_s || s.accel.cwiseAbs().maxCoeff() > p_.max_accel_m_s2) {
-    ++counters_.imu_out_of_range;
-    return refuse("IMU sample at utime " + utime_str(s.utime) + ": beyond max_gyro_rad_s " + fmt(p_.max_gyro_rad_s, 1) +
-                  " or max_accel_m_s2 " + fmt(p_.max_accel_m_s2, 1));
+  if (s.gyro.cwiseAbs().maxCoeff() > p.max_gyro_rad_s || s.accel.cwiseAbs().maxCoeff() > p.max_accel_m_s2) {
+    ++counters.imu_out_of_range;
+    return refuse("IMU sample at utime " + utime_str(s.utime) + ": beyond max_gyro_rad_s " + fmt(p.max_gyro_rad_s, 1) +
+                  " or max_accel_m_s2 " + fmt(p.max_accel_m_s2, 1));
   }
-  const bool have_prev = initialised() || !static_.empty();
-  const int64_t prev = initialised() ? history_.back().imu.utime : (static_.empty() ? 0 : static_.back().utime);
-  if (have_prev && s.utime <= prev) {
-    ++counters_.imu_time_not_increasing;
-    return refuse("IMU sample at utime " + utime_str(s.utime) + " is not after the previous one (" + utime_str(prev) +
+  if (prev && s.utime <= *prev) {
+    ++counters.imu_time_not_increasing;
+    return refuse("IMU sample at utime " + utime_str(s.utime) + " is not after the previous one (" + utime_str(*prev) +
                   "): time went back or repeated");
   }
-  ++counters_.imu_accepted;
-  const int64_t max_dt_us = static_cast<int64_t>(std::llround(p_.max_imu_dt_s * 1e6));
+  ++counters.imu_accepted;
+  const int64_t max_dt_us = static_cast<int64_t>(std::llround(p.max_imu_dt_s * 1e6));
   Outcome o{true, ""};
-  if (have_prev && s.utime - prev > max_dt_us) {
-    ++counters_.imu_gaps;
-    o.reason = "IMU gap of " + fmt((s.utime - prev) * 1e-6) + " s > max_imu_dt_s " + fmt(p_.max_imu_dt_s) +
-               (initialised() ? ": bridged by holding the previous sample" : ": static alignment restarted");
+  if (prev && s.utime - *prev > max_dt_us) {
+    ++counters.imu_gaps;
+    o.reason = "IMU gap of " + fmt((s.utime - *prev) * 1e-6) + " s > max_imu_dt_s " + fmt(p.max_imu_dt_s) +
+               (aligned ? ": bridged by holding the previous sample" : ": static alignment restarted");
   }
+  return o;
+}
+
+Outcome Eskf::add_imu(const ImuSample& s) {
+  std::optional<int64_t> prev;
+  if (initialised()) prev = history_.back().imu.utime;
+  else if (!static_.empty()) prev = static_.back().utime;
+  const Outcome o = check_imu(p_, s, prev, initialised(), counters_);
+  if (!o.accepted) return o;
   if (!initialised()) {
     try_align(s);
     return o;
@@ -239,38 +246,44 @@ void Eskf::resume(const Snapshot& s, const ImuSample& first, const GapNoise& gap
 // follows [S eq. 260] integrated with the mean of the two samples (midpoint / trapezoid, second
 // order); the error covariance P <- F P F^T + Q with F of [S eq. 269] and the noise of
 // [S eqs. 270-273] from continuous densities (variance = density^2 dt).
-void Eskf::propagate(const ImuSample& a, const ImuSample& b) {
+bool imu_step(const EskfParams& p, NominalState& x, const ImuSample& a, const ImuSample& b, Mat15& F, Mat15& Q) {
   const double dt = static_cast<double>(b.utime - a.utime) * 1e-6;
-  if (dt <= 0.0) return;
-  const Vec3 g(0.0, 0.0, -p_.gravity_m_s2);
-  const Vec3 wa = a.gyro - x_.bg, wb = b.gyro - x_.bg;
-  const Vec3 fa = a.accel - x_.ba, fb = b.accel - x_.ba;
+  if (dt <= 0.0) return false;
+  const Vec3 g(0.0, 0.0, -p.gravity_m_s2);
+  const Vec3 wa = a.gyro - x.bg, wb = b.gyro - x.bg;
+  const Vec3 fa = a.accel - x.ba, fb = b.accel - x.ba;
   const Vec3 w = 0.5 * (wa + wb);
   const Vec3 f = 0.5 * (fa + fb);
-  const Mat3 Ra = x_.q.toRotationMatrix();
+  const Mat3 Ra = x.q.toRotationMatrix();
   const Mat3 dR = Exp(w * dt);
 
   // Nominal state [S eq. 260]: q <- q (x) q{w dt}; a_world = R (a_m - a_b) + g.
-  x_.q = (x_.q * Eigen::Quaterniond(dR)).normalized();
-  const Mat3 Rb = x_.q.toRotationMatrix();
+  x.q = (x.q * Eigen::Quaterniond(dR)).normalized();
+  const Mat3 Rb = x.q.toRotationMatrix();
   const Vec3 acc = 0.5 * ((Ra * fa + g) + (Rb * fb + g));
-  x_.p += x_.v * dt + 0.5 * acc * dt * dt;
-  x_.v += acc * dt;
-  x_.utime = b.utime;
+  x.p += x.v * dt + 0.5 * acc * dt * dt;
+  x.v += acc * dt;
+  x.utime = b.utime;
 
   // Error-state transition [S eq. 269] (local attitude error).
-  Mat15 F = Mat15::Identity();
+  F = Mat15::Identity();
   F.block<3, 3>(kP, kV) = Mat3::Identity() * dt;
   F.block<3, 3>(kV, kTheta) = -Ra * hat(f) * dt;
   F.block<3, 3>(kV, kBa) = -Ra * dt;
   F.block<3, 3>(kTheta, kTheta) = dR.transpose();
   F.block<3, 3>(kTheta, kBg) = -Mat3::Identity() * dt;
   // Impulse covariances [S eqs. 270-273].
-  Mat15 Q = Mat15::Zero();
-  Q.block<3, 3>(kV, kV) = std::pow(p_.accel_noise_density, 2) * dt * Mat3::Identity();
-  Q.block<3, 3>(kTheta, kTheta) = std::pow(p_.gyro_noise_density, 2) * dt * Mat3::Identity();
-  Q.block<3, 3>(kBg, kBg) = std::pow(p_.gyro_random_walk, 2) * dt * Mat3::Identity();
-  Q.block<3, 3>(kBa, kBa) = std::pow(p_.accel_random_walk, 2) * dt * Mat3::Identity();
+  Q = Mat15::Zero();
+  Q.block<3, 3>(kV, kV) = std::pow(p.accel_noise_density, 2) * dt * Mat3::Identity();
+  Q.block<3, 3>(kTheta, kTheta) = std::pow(p.gyro_noise_density, 2) * dt * Mat3::Identity();
+  Q.block<3, 3>(kBg, kBg) = std::pow(p.gyro_random_walk, 2) * dt * Mat3::Identity();
+  Q.block<3, 3>(kBa, kBa) = std::pow(p.accel_random_walk, 2) * dt * Mat3::Identity();
+  return true;
+}
+
+void Eskf::propagate(const ImuSample& a, const ImuSample& b) {
+  Mat15 F, Q;
+  if (!imu_step(p_, x_, a, b, F, Q)) return;
   P_ = F * P_ * F.transpose() + Q;
   P_ = 0.5 * (P_ + P_.transpose());
 }
@@ -279,12 +292,12 @@ void Eskf::advance(size_t j) {
   const ImuSample a = history_[j].imu;
   const ImuSample b = history_[j + 1].imu;
   const bool hold = static_cast<double>(b.utime - a.utime) > p_.max_imu_dt_s * 1e6;  // a gap
-  const ImuSample b_used = hold ? interpolate(a, b, b.utime, true) : b;
+  const ImuSample b_used = hold ? interpolate_imu(a, b, b.utime, true) : b;
   ImuSample cur = a;
-  if (hold) cur = interpolate(a, b, a.utime, true);
+  if (hold) cur = interpolate_imu(a, b, a.utime, true);
   // VO poses strictly between the two samples: propagate to each, update.
   for (auto it = vo_.upper_bound(a.utime); it != vo_.end() && it->first < b.utime; ++it) {
-    const ImuSample c = interpolate(a, b, it->first, hold);
+    const ImuSample c = interpolate_imu(a, b, it->first, hold);
     propagate(cur, c);
     cur = c;
     apply(it->second);

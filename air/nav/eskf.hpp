@@ -153,6 +153,18 @@ struct Alignment {
   double roll_rad = 0, pitch_rad = 0;
 };
 
+// Shared with the monocular filter (air/nav/msf.hpp):
+// The IMU sample at time t inside [a, b]: linear interpolation, or a held (when the step is a gap).
+ImuSample interpolate_imu(const ImuSample& a, const ImuSample& b, int64_t t, bool hold);
+// The input checks of Eskf::add_imu against the previous accepted sample's time (nullopt: none);
+// counts the refusals and the accepted sample; the outcome's reason names a gap (aligned: bridged).
+Outcome check_imu(const EskfParams& p, const ImuSample& s, std::optional<int64_t> prev, bool aligned,
+                  EskfCounters& counters);
+// One propagation step from sample a to b (b may be interpolated): the nominal state x follows
+// [S eq. 260] with midpoint integration; F is the error-state transition [S eq. 269] and Q the
+// impulse covariances [S eqs. 270-273] over it. False (x unchanged) when b is not after a.
+bool imu_step(const EskfParams& p, NominalState& x, const ImuSample& a, const ImuSample& b, Mat15& F, Mat15& Q);
+
 class Eskf {
  public:
   explicit Eskf(EskfParams params);

@@ -36,6 +36,51 @@ geometry::SE3 sim_forward_rig_T_body_cam() {
   return geometry::SE3(R, Eigen::Vector3d(0, 0.06, 0));
 }
 
+namespace {
+
+// The mono: section (config/nav.yaml documents every key).
+void load_mono(const util::Config& cfg, NavConfig& out) {
+  MonoParams& m = out.mono;
+  struct Mono {
+    std::string channel, noise;
+    double scale_prior, scale_prior_sigma, scale_sigma_ok, scale_random_walk, frame_rotation_random_walk_deg,
+        frame_position_random_walk_m, rotation_sigma_deg, position_sigma_m, min_velocity_change_m_s;
+    int jump_poses;
+  } v{out.mono_channel, m.noise == VoNoise::Message ? "message" : "config", m.scale_prior, m.scale_prior_sigma,
+      m.scale_sigma_ok, m.scale_random_walk, m.frame_rotation_random_walk_rad / kDeg, m.frame_position_random_walk_m,
+      m.rotation_sigma_rad / kDeg, m.position_sigma_m, m.min_velocity_change_m_s, m.jump_poses};
+  util::SectionReader<Mono>(cfg.section("mono"), v)("channel", &Mono::channel)("noise", &Mono::noise)(
+      "scale_prior", &Mono::scale_prior)("scale_prior_sigma", &Mono::scale_prior_sigma)(
+      "scale_sigma_ok", &Mono::scale_sigma_ok)("scale_random_walk", &Mono::scale_random_walk)(
+      "frame_rotation_random_walk_deg", &Mono::frame_rotation_random_walk_deg)(
+      "frame_position_random_walk_m", &Mono::frame_position_random_walk_m)("rotation_sigma_deg", &Mono::rotation_sigma_deg)(
+      "position_sigma_m", &Mono::position_sigma_m)("min_velocity_change_m_s", &Mono::min_velocity_change_m_s)(
+      "jump_poses", &Mono::jump_poses)
+      .finish();
+  if (v.channel.empty()) throw std::runtime_error(cfg.origin() + ": mono.channel must not be empty");
+  out.mono_channel = v.channel;
+  if (v.noise == "message") m.noise = VoNoise::Message;
+  else if (v.noise == "config") m.noise = VoNoise::Config;
+  else throw std::runtime_error(cfg.origin() + ": mono.noise must be message or config, not '" + v.noise + "'");
+  m.scale_prior = v.scale_prior;
+  m.scale_prior_sigma = v.scale_prior_sigma;
+  m.scale_sigma_ok = v.scale_sigma_ok;
+  m.scale_random_walk = v.scale_random_walk;
+  m.frame_rotation_random_walk_rad = v.frame_rotation_random_walk_deg * kDeg;
+  m.frame_position_random_walk_m = v.frame_position_random_walk_m;
+  m.rotation_sigma_rad = v.rotation_sigma_deg * kDeg;
+  m.position_sigma_m = v.position_sigma_m;
+  m.min_velocity_change_m_s = v.min_velocity_change_m_s;
+  m.jump_poses = v.jump_poses;
+  try {
+    m.validate();
+  } catch (const std::invalid_argument& ex) {
+    throw std::runtime_error(cfg.origin() + ": " + ex.what());
+  }
+}
+
+}  // namespace
+
 NavConfig load_nav_config(const util::Config& cfg) {
   NavConfig out;
   EskfParams& e = out.eskf;
@@ -43,9 +88,11 @@ NavConfig load_nav_config(const util::Config& cfg) {
   struct Top {
     double gravity_m_s2, publish_rate_hz, buffer_s;
     int max_pending_vo;
-  } top{e.gravity_m_s2, out.publish_rate_hz, e.buffer_s, e.max_pending_vo};
+    std::string source;
+  } top{e.gravity_m_s2, out.publish_rate_hz, e.buffer_s, e.max_pending_vo, "stereo"};
   util::SectionReader<Top>(cfg, top)("gravity_m_s2", &Top::gravity_m_s2)("publish_rate_hz", &Top::publish_rate_hz)(
-      "buffer_s", &Top::buffer_s)("max_pending_vo", &Top::max_pending_vo)
+      "buffer_s", &Top::buffer_s)("max_pending_vo", &Top::max_pending_vo)("source", &Top::source)
+      .known("mono")
       .known("imu")
       .known("alignment")
       .known("camera")
@@ -59,6 +106,13 @@ NavConfig load_nav_config(const util::Config& cfg) {
   out.publish_rate_hz = top.publish_rate_hz;
   e.buffer_s = top.buffer_s;
   e.max_pending_vo = top.max_pending_vo;
+  if (top.source == "stereo") out.source = NavConfig::Source::Stereo;
+  else if (top.source == "mono") out.source = NavConfig::Source::Mono;
+  else throw std::runtime_error(cfg.origin() + ": source must be stereo or mono, not '" + top.source + "'");
+  load_mono(cfg, out);
+  if (out.source == NavConfig::Source::Mono && cfg.section("resume").has("state_file") &&
+      !cfg.section("resume").get<std::string>("state_file", "").empty())
+    throw std::runtime_error(cfg.origin() + ": resume.state_file is for source: stereo only (the mono filter does not resume)");
   if (!(out.publish_rate_hz >= 0.0) || !std::isfinite(out.publish_rate_hz))
     throw std::runtime_error(cfg.origin() + ": publish_rate_hz must be >= 0 (0 = every IMU sample)");
 

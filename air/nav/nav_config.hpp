@@ -4,6 +4,7 @@
 #include <string>
 
 #include "air/nav/eskf.hpp"
+#include "air/nav/msf.hpp"
 #include "common/util/config.hpp"
 #include "common/util/message_clock.hpp"
 
@@ -11,6 +12,10 @@ namespace aerie::nav {
 
 struct NavConfig {
   EskfParams eskf;
+  // source: stereo (VO_POSE, metric: the Eskf) or mono (mono.channel, arbitrary scale: the MonoEskf).
+  enum class Source { Stereo, Mono } source = Source::Stereo;
+  MonoParams mono;
+  std::string mono_channel = "MONO_POSE";
   double publish_rate_hz = 0.0;  // NAV_STATE rate in message time; 0 = every accepted IMU sample
   // The node's message-time policy per source (the IMU; the VO's camera): a stamp more than
   // 1 s from the newest is held, so one bogus stamp never moves the filter's clock

@@ -25,6 +25,27 @@ int8_t to_message(NavStatus s) {
 
 }  // namespace
 
+void fill_nav_state(aerie::nav_state_t& m, const NominalState& x, const Mat15& P, double time_since_vo_s) {
+  for (int i = 0; i < 3; ++i) {
+    m.position[i] = x.p[i];
+    m.velocity[i] = x.v[i];
+    m.gyro_bias[i] = x.bg[i];
+    m.accel_bias[i] = x.ba[i];
+    for (int j = 0; j < 3; ++j) {
+      m.position_covariance[3 * i + j] = P(kP + i, kP + j);
+      m.attitude_covariance[3 * i + j] = P(kTheta + i, kTheta + j);
+    }
+  }
+  for (int i = 0; i < kErrorDim; ++i) m.covariance_diagonal[i] = P(i, i);
+  m.orientation[0] = x.q.w();
+  m.orientation[1] = x.q.x();
+  m.orientation[2] = x.q.y();
+  m.orientation[3] = x.q.z();
+  m.time_since_vo_s = time_since_vo_s;
+}
+
+int8_t nav_status_to_message(NavStatus s) { return to_message(s); }
+
 NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
     : bus_(bus),
       cfg_(std::move(config)),
@@ -51,8 +72,8 @@ NavNode::NavNode(bus::Bus& bus, NavConfig config, NavNodeOptions options)
       return;
     }
     if (!o.reason.empty()) {  // a gap, bridged
-      last_error_ = opt_.imu_channel + ": " + o.reason;
-      spdlog::warn("{}", last_error_);
+      log_.last_error = opt_.imu_channel + ": " + o.reason;
+      spdlog::warn("{}", log_.last_error);
     }
     ++counters_["imu"];
     const int64_t period_us =
@@ -134,26 +155,33 @@ void NavNode::keep_snapshot() {
   }
 }
 
-std::optional<util::MessageClock::Verdict> NavNode::admit(util::MessageClock& clock, const std::string& channel,
-                                                          int64_t utime) {
+std::optional<util::MessageClock::Verdict> admit_message_time(util::MessageClock& clock, const std::string& channel,
+                                                              int64_t utime, std::map<std::string, int64_t>& counters,
+                                                              const std::string& held, RefusalLog& log) {
   // Staleness is the filter's own (outage.*, on message time): the node clock is not used.
   const util::MessageClock::Result r = clock.observe(utime, 0);
   if (r.verdict == util::MessageClock::Verdict::kResynced) spdlog::info("{}: {}", channel, r.reason);
   if (r.accepted()) return r.verdict;
-  ++counters_[channel == opt_.imu_channel ? "imu_time_held" : "vo_time_held"];
-  refused(channel, r.reason);
+  ++counters[held];
+  log.refused(channel, r.reason);
   return std::nullopt;
 }
 
-void NavNode::refused(const std::string& what, const std::string& why) {
-  last_error_ = what + ": " + why;
-  // Every refusal is counted; the log shows the 1st, 10th, 100th, ... per channel, so that a
-  // stream of them (VO poses before the alignment, a broken IMU) does not flood it.
-  const int64_t n = ++refusals_[what];
+std::optional<util::MessageClock::Verdict> NavNode::admit(util::MessageClock& clock, const std::string& channel,
+                                                          int64_t utime) {
+  return admit_message_time(clock, channel, utime, counters_, channel == opt_.imu_channel ? "imu_time_held" : "vo_time_held",
+                            log_);
+}
+
+void RefusalLog::refused(const std::string& what, const std::string& why) {
+  last_error = what + ": " + why;
+  const int64_t n = ++per_channel[what];
   int64_t p = 1;
   while (p < n) p *= 10;
-  if (p == n) spdlog::warn("{} ({} refused on {} so far)", last_error_, n, what);
+  if (p == n) spdlog::warn("{} ({} refused on {} so far)", last_error, n, what);
 }
+
+void NavNode::refused(const std::string& what, const std::string& why) { log_.refused(what, why); }
 
 void NavNode::publish() {
   const NavStatus s = eskf_.status();
@@ -169,25 +197,7 @@ void NavNode::publish() {
   m.status = to_message(s);
   m.reason = eskf_.status_reason();
   m.orientation[0] = 1.0;
-  if (eskf_.initialised()) {
-    const Mat15 P = eskf_.covariance_world_attitude();
-    for (int i = 0; i < 3; ++i) {
-      m.position[i] = x.p[i];
-      m.velocity[i] = x.v[i];
-      m.gyro_bias[i] = x.bg[i];
-      m.accel_bias[i] = x.ba[i];
-      for (int j = 0; j < 3; ++j) {
-        m.position_covariance[3 * i + j] = P(kP + i, kP + j);
-        m.attitude_covariance[3 * i + j] = P(kTheta + i, kTheta + j);
-      }
-    }
-    for (int i = 0; i < kErrorDim; ++i) m.covariance_diagonal[i] = P(i, i);
-    m.orientation[0] = x.q.w();
-    m.orientation[1] = x.q.x();
-    m.orientation[2] = x.q.y();
-    m.orientation[3] = x.q.z();
-    m.time_since_vo_s = eskf_.time_since_update_s();
-  }
+  if (eskf_.initialised()) fill_nav_state(m, x, eskf_.covariance_world_attitude(), eskf_.time_since_update_s());
   m.vo_applied = static_cast<int32_t>(eskf_.counters().vo_applied);
   m.vo_gated = static_cast<int32_t>(eskf_.counters().vo_gated);
   bus_.publish(opt_.state_channel, m);
@@ -227,8 +237,8 @@ void NavNode::report(bus::StatusReporter& status) const {
     status.error(msg);
   else if (s == NavStatus::ImuOnly)
     status.warn(msg);
-  else if (!last_error_.empty())
-    status.warn(msg + " (last refused input: " + last_error_ + ")");
+  else if (!log_.last_error.empty())
+    status.warn(msg + " (last refused input: " + log_.last_error + ")");
   else
     status.ok(msg);
 }

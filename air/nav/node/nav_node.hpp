@@ -17,7 +17,29 @@
 #include "common/bus/status.hpp"
 #include "common/util/message_clock.hpp"
 
+namespace aerie {
+class nav_state_t;
+}
+
 namespace aerie::nav {
+
+// The state fields of NAV_STATE from the nominal state and the 15x15 covariance with the attitude
+// error in the world frame (shared by the stereo and the mono node).
+void fill_nav_state(aerie::nav_state_t& m, const NominalState& x, const Mat15& P_world_attitude, double time_since_vo_s);
+int8_t nav_status_to_message(NavStatus s);
+
+// The nodes' refusals: the last one, and a log that shows the 1st, 10th, 100th, ... per channel,
+// so that a stream of them (VO poses before the alignment, a broken IMU) does not flood it.
+struct RefusalLog {
+  std::map<std::string, int64_t> per_channel;
+  std::string last_error;
+  void refused(const std::string& what, const std::string& why);
+};
+// The nodes' message-time policy (NavConfig::message_time): nullopt for a held stamp (counted in
+// counters[held], logged); else the verdict (kResynced: the source restarted or came back).
+std::optional<util::MessageClock::Verdict> admit_message_time(util::MessageClock& clock, const std::string& channel,
+                                                              int64_t utime, std::map<std::string, int64_t>& counters,
+                                                              const std::string& held, RefusalLog& log);
 
 struct NavNodeOptions {
   std::string imu_channel = channels::kImu;
@@ -49,8 +71,7 @@ class NavNode {
   Eskf eskf_;
   util::MessageClock imu_time_, vo_time_;
   std::map<std::string, int64_t> counters_;
-  std::map<std::string, int64_t> refusals_;  // per channel, for the log's throttle
-  std::string last_error_;
+  RefusalLog log_;
   NavStatus last_status_ = NavStatus::Initialising;
   int64_t seq_ = 0;
   int64_t last_publish_utime_ = INT64_MIN;
