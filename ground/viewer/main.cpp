@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include <random>
 #include <thread>
 
+#include "air/nav/nav_config.hpp"
 #include "common/bus/node.hpp"
 #include "common/util/cli.hpp"
 #include "common/util/heap.hpp"
@@ -66,12 +68,30 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--duration", duration, "exit after this many seconds (headless runs)");
   app.add_option("--disable", disable, "renderers to start disabled (by name, e.g. octomap chart-latency)");
+  std::string nav_config;
+  app.add_option("--nav-config", nav_config,
+                 "aerie-nav's YAML: its camera.T_body_cam (EuRoC: cam0's T_BS) turns IMU gravity into the display's "
+                 "z up when no GT_POSE comes (default: the simulator's forward rig)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--align-period", opts.align_period_s,
+                 "seconds between two alignments of GT_POSE to VO_POSE (SE(3), as aerie-eval-traj; 'g': now)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--frame-vehicle", opts.frame_vehicle,
+               "look at the vehicle's start from 8 m once the 3D scene's frame is known (default: the whole scene)");
   std::string key_path;
   app.add_option("--key", key_path,
                  "mission key file (mode 0600): the process panel's start/stop orders are tagged as a keyed "
                  "sheriff's (PMD_ORDERS2_SEALED); without it they are libbot2's plain PMD_ORDERS2, which keyed "
                  "deputies refuse");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", "aerie-viewer", e.what());
+    return 2;
+  }
   aerie::util::init_logging("viewer", common.log_level);
   aerie::util::map_large_blocks();  // util/heap.hpp
 
@@ -83,6 +103,8 @@ int main(int argc, char** argv) {
   }
   if (!record_dir.empty()) std::filesystem::create_directories(record_dir);
   try {
+    if (!nav_config.empty())
+      opts.T_body_cam = aerie::nav::load_nav_config(aerie::util::Config::load(nav_config)).eskf.T_body_cam;
     aerie::bus::Bus bus(common.lcm_url);
     aerie::viewer::Viewer viewer(bus, opts);
     viewer.add_default_renderers();

@@ -15,10 +15,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "air/track/factory.hpp"
+#include "air/nav/nav_config.hpp"
 #include "air/track/node/default_tracker.hpp"
 #include "common/bus/node.hpp"
 #include "common/util/heap.hpp"
 #include "common/util/time.hpp"
+#include "ground/viewer/keys.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -68,18 +70,31 @@ Renderer& Viewer::add(std::unique_ptr<Renderer> renderer) {
 }
 
 void Viewer::add_default_renderers() {
+  // The display frame first built, added last (renderers 1-9 keep their numbers); the
+  // scene's renderers follow it.
+  WorldFrameRenderer::Options wo;
+  wo.T_body_cam = options_.T_body_cam ? *options_.T_body_cam : nav::sim_forward_rig_T_body_cam();
+  wo.align_period_s = options_.align_period_s;
+  wo.frame_vehicle = options_.frame_vehicle;
+  wo.max_poses = options_.trajectory_poses;
+  auto world = std::make_unique<WorldFrameRenderer>(wo);
+  auto in_world = [&](auto renderer) {
+    renderer->set_world(world.get());
+    return renderer;
+  };
   add(std::make_unique<CameraRenderer>(options_.image_channel));
   add(std::make_unique<TrackOverlay>());
   add(std::make_unique<GtBoxOverlay>());
   add(std::make_unique<PilotOverlay>());
   add(std::make_unique<GridRenderer>());
-  add(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false, options_.trajectory_poses));
-  add(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true, options_.trajectory_poses));
-  add(std::make_unique<DepthCloudRenderer>());
-  add(std::make_unique<OctomapRenderer>("MAP_OCTOMAP", options_.map_max_quads));
-  add(std::make_unique<TargetPoseRenderer>());
+  add(in_world(std::make_unique<PoseRenderer>("vo-pose", "VO_POSE", false, options_.trajectory_poses)));
+  add(in_world(std::make_unique<PoseRenderer>("gt-pose", "GT_POSE", true, options_.trajectory_poses)));
+  add(in_world(std::make_unique<DepthCloudRenderer>()));
+  add(in_world(std::make_unique<OctomapRenderer>("MAP_OCTOMAP", options_.map_max_quads)));
+  add(in_world(std::make_unique<TargetPoseRenderer>()));
   add_default_charts(*this);
   add(std::make_unique<ProcmanPanel>());
+  add(std::move(world));
 }
 
 Renderer* Viewer::find(const std::string& name) const {
@@ -305,14 +320,28 @@ void Viewer::on_key(const std::string& key) {
   redraw_all();
 }
 
-void Viewer::update_help_text() {
-  std::string s = "drag: track box  t: tracker [" + current_tracker() + "]  x: stop  r: reset  c: view  p: pause" +
-                  (paused_ ? " (PAUSED)" : "") + "\n";
+std::string Viewer::help_text() const {
+  // Every key of keys.hpp (the table docs/viewer.md lists), wrapped to the pane.
+  constexpr size_t kLine = 72;
+  std::string s, line;
+  for (const auto& k : kKeys) {
+    std::string item = std::string(k.key) + ": " + std::string(k.overlay);
+    if (k.key == "t") item += " [" + current_tracker() + "]";
+    if (k.key == "p" && paused_) item += " (PAUSED)";
+    if (!line.empty() && line.size() + 2 + item.size() > kLine) {
+      s += line + "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : "  ") + item;
+  }
+  s += line + "\n";
   for (size_t i = 0; i < renderers_.size() && i < 9; ++i)
     s += std::to_string(i + 1) + (renderers_[i]->enabled() ? ":[x] " : ":[ ] ") + renderers_[i]->name() +
          (i % 5 == 4 ? "\n" : "  ");
-  help_->text->SetInput(s.c_str());
+  return s;
 }
+
+void Viewer::update_help_text() { help_->text->SetInput(help_text().c_str()); }
 
 namespace {
 

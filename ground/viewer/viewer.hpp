@@ -15,6 +15,7 @@
 
 #include "common/bus/bus.hpp"
 #include "common/bus/status.hpp"
+#include "common/geometry/se3.hpp"
 #include "ground/viewer/image_pane.hpp"
 #include "ground/viewer/layout.hpp"
 #include "ground/viewer/renderer.hpp"
@@ -49,6 +50,12 @@ struct ViewerOptions {
   // Freed memory that glibc's arenas hold is handed back to the kernel this often
   // (util::trim_heap, common/util/heap.hpp); 0: never.
   double trim_period_s = 10;
+  // The display frame (world_frame.hpp): the camera in the IMU's body frame, for gravity
+  // from IMU (default: the simulator's forward rig, nav::sim_forward_rig_T_body_cam), and
+  // how often the ground truth is aligned to the estimate.
+  std::optional<geometry::SE3> T_body_cam;  // nullopt: the simulator's forward rig
+  double align_period_s = 2.0;
+  bool frame_vehicle = false;  // WorldFrameRenderer::Options::frame_vehicle
   std::string image_channel = "CAM_LEFT";
   std::string track_cmd_channel = "TRACK_CMD";
   std::vector<std::string> trackers = tracker_cycle();
@@ -82,9 +89,12 @@ class Viewer {
   void drag_selection(double x, double y);
   // Sends TRACK_CMD INIT for the selected box in image pixels; returns it when sent.
   std::optional<cv::Rect2d> end_selection(double x, double y);
-  // Keys: 't' next tracker, 'x' stop, 'r' reset tracking, 'c' reset cameras,
-  // 'p' pause/resume, '1'..'9' toggle renderer N, 'h' toggle the help text.
+  // Keys (keys.hpp): 't' next tracker, 'x' stop, 'r' reset tracking, 'c' reset cameras,
+  // 'p' pause/resume, '1'..'9' toggle renderer N, 'h' toggle the help text; the others go
+  // to the renderers.
   void on_key(const std::string& key);
+  // The help overlay's text: every key of keys.hpp, then renderers 1-9 and their state.
+  std::string help_text() const;
   void send_track_command(int8_t command, const std::optional<cv::Rect2d>& box = std::nullopt);
 
   const std::string& current_tracker() const { return options_.trackers[tracker_index_]; }

@@ -13,8 +13,6 @@
 namespace aerie::latency {
 namespace {
 
-constexpr double kDayMs = 86'400'000.0;
-
 std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -60,34 +58,54 @@ void LatencyAnalysis::add(const std::string& channel, int64_t log_utime, const u
       // A heartbeat of an idle node repeats its last hop: count each hop once.
       if (st.last_source_utime != h.last_source || st.last_receive_utime != h.last_receive ||
           st.last_publish_utime != h.last_publish) {
-        h.input.push_back(static_cast<double>(st.last_receive_utime - st.last_source_utime) / 1000.0);
+        // The source's time on the node's clock: its utime live, its frame's first arrival
+        // in the log when it is stamped by another clock (source_clock.hpp).
+        std::optional<int64_t> source = st.last_source_utime;
+        if (!on_receive_clock(st.last_source_utime, st.last_receive_utime)) {
+          h.source_clock = true;
+          const auto* first = arrivals_.find(st.last_source_utime);
+          source = first ? std::optional(first->receive_utime) : std::nullopt;
+        }
+        if (source) {
+          h.input.push_back(static_cast<double>(st.last_receive_utime - *source) / 1000.0);
+          h.age.push_back(static_cast<double>(st.last_publish_utime - *source) / 1000.0);
+        }
         h.processing.push_back(static_cast<double>(st.last_publish_utime - st.last_receive_utime) / 1000.0);
-        h.age.push_back(static_cast<double>(st.last_publish_utime - st.last_source_utime) / 1000.0);
         h.last_source = st.last_source_utime;
         h.last_receive = st.last_receive_utime;
         h.last_publish = st.last_publish_utime;
       }
     }
   }
+  const logtools::TypeInfo* type = logtools::find_type(fp);
+  const auto utime = bus::peek_utime(data, size);
+  const bool stamped = (type || options_.unknown_types) && utime && *utime > 0;
+  // Every frame's first arrival, whatever the channel filter: the reference of the channels
+  // stamped by another clock.
+  // (Heartbeats are stamped when sent, not by a frame: never a frame's arrival.)
+  std::optional<Measured> m;
+  if (stamped && channel.rfind("STATUS_", 0) != 0)
+    m = measure(arrivals_, channel, *utime, log_utime);
+  else if (stamped && on_receive_clock(*utime, log_utime))
+    m = Measured{static_cast<double>(log_utime - *utime) / 1000.0, false, ""};
   auto [it, fresh] = matches_.try_emplace(channel, false);
   if (fresh) it->second = std::regex_match(channel, channel_re_);
   if (!it->second) return;
   Acc& a = channels_[channel];
   ++a.messages;
-  const logtools::TypeInfo* type = logtools::find_type(fp);
   if (type) a.type = type->name;
-  const auto utime = bus::peek_utime(data, size);
-  if ((!type && !options_.unknown_types) || !utime) {
+  if (!stamped) {
     ++a.unstamped;
     return;
   }
-  const double ms = static_cast<double>(log_utime - *utime) / 1000.0;
-  if (std::fabs(ms) > kDayMs) {
-    ++a.other_clock;
+  if (!on_receive_clock(*utime, log_utime)) ++a.other_clock;
+  if (!m) {
+    ++a.references;
     return;
   }
-  if (ms < 0) ++a.negative;
-  a.ms.push_back(ms);
+  if (m->source_clock) a.reference = m->reference;
+  if (m->ms < 0) ++a.negative;
+  a.ms.push_back(m->ms);
 }
 
 std::vector<ChannelLatency> LatencyAnalysis::channels() const {
@@ -100,6 +118,8 @@ std::vector<ChannelLatency> LatencyAnalysis::channels() const {
     c.messages = a.messages;
     c.unstamped = a.unstamped;
     c.other_clock = a.other_clock;
+    c.references = a.references;
+    c.reference = a.reference;
     c.negative = a.negative;
     out.push_back(std::move(c));
   }
@@ -109,21 +129,26 @@ std::vector<ChannelLatency> LatencyAnalysis::channels() const {
 std::vector<HopLatency> LatencyAnalysis::hops() const {
   std::vector<HopLatency> out;
   for (const auto& [node, h] : hops_)
-    out.push_back({node, summarize(h.input), summarize(h.processing), summarize(h.age)});
+    out.push_back({node, summarize(h.input), summarize(h.processing), summarize(h.age), h.source_clock});
   return out;
 }
 
 std::string format_table(const std::vector<ChannelLatency>& channels, const std::vector<HopLatency>& hops) {
   std::ostringstream os;
   char b[512];
-  os << "End-to-end latency per channel: log receive time - message utime (ms)\n";
+  os << "End-to-end latency per channel: log receive time - message utime (ms); stamps more than 1 h off\n"
+        "the log's clock (recorded data): log receive time - that frame's first arrival in the log\n";
   std::snprintf(b, sizeof b, "%-22s %-28s %8s %9s %9s %9s %9s  %s\n", "CHANNEL", "TYPE", "N", "MEDIAN", "P90", "P99",
                 "MAX", "NOTES");
   os << b;
   for (const auto& c : channels) {
     std::string notes;
     if (c.unstamped) notes += std::to_string(c.unstamped) + " without utime; ";
-    if (c.other_clock) notes += std::to_string(c.other_clock) + " stamped by another clock (dataset time?); ";
+    if (c.other_clock) {
+      notes += std::to_string(c.other_clock) + " stamped by another clock (dataset time?): ";
+      notes += c.reference.empty() ? "first arrivals, no latency; "
+                                   : "latency from the frame's first arrival on " + c.reference + "; ";
+    }
     if (c.negative) notes += std::to_string(c.negative) + " negative: clocks differ; ";
     const auto& s = c.latency_ms;
     if (s.count > 0)
@@ -137,7 +162,8 @@ std::string format_table(const std::vector<ChannelLatency>& channels, const std:
   }
   if (!hops.empty()) {
     os << "\nPer hop, from the nodes' STATUS_* heartbeats (ms): input = receive - source utime,\n"
-          "processing = publish - receive, age = publish - source utime\n";
+          "processing = publish - receive, age = publish - source utime (a source on another clock: its\n"
+          "frame's first arrival in the log instead of its utime; marked *)\n";
     std::snprintf(b, sizeof b, "%-16s %6s  %-26s  %-26s  %-26s\n", "NODE", "N", "INPUT median/p90/max",
                   "PROCESSING median/p90/max", "AGE median/p90/max");
     os << b;
@@ -147,7 +173,7 @@ std::string format_table(const std::vector<ChannelLatency>& channels, const std:
       return std::string(t);
     };
     for (const auto& h : hops) {
-      std::snprintf(b, sizeof b, "%-16s %6lld  %-26s  %-26s  %-26s\n", h.node.c_str(),
+      std::snprintf(b, sizeof b, "%-16s %6lld  %-26s  %-26s  %-26s\n", (h.node + (h.source_clock ? " *" : "")).c_str(),
                     static_cast<long long>(h.input_ms.count), three(h.input_ms).c_str(),
                     three(h.processing_ms).c_str(), three(h.age_ms).c_str());
       os << b;
@@ -175,14 +201,16 @@ std::string to_json(const std::vector<ChannelLatency>& channels, const std::vect
     const auto& c = channels[i];
     os << (i ? "," : "") << "\n    {\"channel\": " << json_string(c.channel) << ", \"type\": " << json_string(c.type)
        << ", \"messages\": " << c.messages << ", \"unstamped\": " << c.unstamped
-       << ", \"other_clock\": " << c.other_clock << ", \"negative\": " << c.negative
+       << ", \"other_clock\": " << c.other_clock << ", \"references\": " << c.references
+       << ", \"reference\": " << json_string(c.reference) << ", \"negative\": " << c.negative
        << ", \"latency_ms\": " << json_summary(c.latency_ms) << "}";
   }
   os << "\n  ],\n  \"hops\": [";
   for (size_t i = 0; i < hops.size(); ++i) {
     const auto& h = hops[i];
     os << (i ? "," : "") << "\n    {\"node\": " << json_string(h.node) << ", \"input_ms\": " << json_summary(h.input_ms)
-       << ", \"processing_ms\": " << json_summary(h.processing_ms) << ", \"age_ms\": " << json_summary(h.age_ms) << "}";
+       << ", \"processing_ms\": " << json_summary(h.processing_ms) << ", \"age_ms\": " << json_summary(h.age_ms)
+       << ", \"source_clock\": " << (h.source_clock ? "true" : "false") << "}";
   }
   os << "\n  ]\n}\n";
   return os.str();

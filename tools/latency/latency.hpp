@@ -7,6 +7,8 @@
 // times they received it and published their result give the per-hop split:
 //   input = receive - source,  processing = publish - receive,  age = publish - source.
 // Times are those of the hosts' clocks: across hosts they must be synchronised.
+// Messages stamped by another clock (recorded datasets) follow source_clock.hpp: their
+// latency is measured from the frame's first arrival in the log.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -14,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/latency/source_clock.hpp"
 #include "tools/latency/stats.hpp"
 
 namespace aerie::latency {
@@ -24,7 +27,9 @@ struct ChannelLatency {
   Summary latency_ms;
   int64_t messages = 0;           // events on the channel
   int64_t unstamped = 0;          // unknown type or too short: no utime
-  int64_t other_clock = 0;        // |latency| over a day: a clock other than the wall clock (dataset time)
+  int64_t other_clock = 0;        // stamped by another clock (|receive - utime| > 1 h: dataset time)
+  int64_t references = 0;         // of those, first arrivals of their frame: the reference, no latency
+  std::string reference;          // the channel the others are measured from ("" when none is)
   int64_t negative = 0;           // received before its utime: the hosts' clocks disagree
 };
 
@@ -33,6 +38,7 @@ struct HopLatency {
   Summary input_ms;               // receive - source
   Summary processing_ms;          // publish - receive
   Summary age_ms;                 // publish - source
+  bool source_clock = false;      // the source on another clock: input and age from the frame's arrival
 };
 
 class LatencyAnalysis {
@@ -55,17 +61,20 @@ class LatencyAnalysis {
   struct Acc {
     std::string type;
     std::vector<double> ms;
-    int64_t messages = 0, unstamped = 0, other_clock = 0, negative = 0;
+    int64_t messages = 0, unstamped = 0, other_clock = 0, references = 0, negative = 0;
+    std::string reference;
   };
   struct HopAcc {
     std::vector<double> input, processing, age;
     int64_t last_source = -1, last_receive = -1, last_publish = -1;
+    bool source_clock = false;
   };
   Options options_;
   std::regex channel_re_;
   std::map<std::string, bool> matches_;
   std::map<std::string, Acc> channels_;
   std::map<std::string, HopAcc> hops_;
+  FrameArrivals arrivals_;
   int64_t events_ = 0;
 };
 

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 
@@ -17,7 +18,11 @@ int main(int argc, char** argv) {
       "aerie-latency: end-to-end latency of every channel of an LCM log (receive time in the log minus\n"
       "the message's source utime) as median/p90/p99/max, and per hop from the nodes' STATUS_* messages.\n"
       "Given a second log (a split deployment: the air side's log, then the ground side's), also the\n"
-      "link's hop per channel: the receiving side's log time minus the sending side's."};
+      "link's hop per channel: the receiving side's log time minus the sending side's.\n"
+      "Recorded data: a utime more than 1 h from the log's receive time (a dataset's own clock, e.g.\n"
+      "EuRoC's) is not on the log's clock; such a message's latency is its receive time minus the\n"
+      "receive time of the first message of the same frame (same utime) in the log, normally the\n"
+      "camera's, and per hop input and age are taken from that arrival (docs/viewer.md \"Latency\")."};
   std::string log_path, ground_log_path, csv, json, log_level = "info";
   latency::LatencyAnalysis::Options opts;
   app.add_option("log", log_path, "LCM log file (lcm-logger); the air side's in a split deployment")
@@ -30,7 +35,14 @@ int main(int argc, char** argv) {
   app.add_option("--csv", csv, "write the figures as CSV");
   app.add_option("--json", json, "write the figures as JSON");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", "aerie-latency", e.what());
+    return 2;
+  }
   util::init_logging("aerie-latency", log_level);
   try {
     latency::LatencyAnalysis analysis(opts);

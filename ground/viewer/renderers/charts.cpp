@@ -159,7 +159,19 @@ void LatencyChart::subscribe(bus::Bus& bus) {
       const auto utime = bus::peek_utime(data, size);
       if (!utime) throw std::invalid_argument("message too short to hold a utime");
       if (*utime <= 0) return;  // no source frame (e.g. a controller hovering without input)
-      last_ms_[i] = static_cast<double>(info.recv_utime - *utime) * 1e-3;
+      // On the source's own clock (tools/latency/source_clock.hpp): dataset stamps are
+      // measured from the frame's first arrival, never as receive time minus a 2015 stamp.
+      std::optional<latency::Measured> m;
+      {
+        std::lock_guard lock(arrivals_m_);
+        m = latency::measure(arrivals_, channels_[i], *utime, info.recv_utime);
+        if (m && m->source_clock && !source_clock_) {
+          chart_title_ = "Latency from arrival on " + m->reference + " (dataset time)";
+          source_clock_ = true;
+        }
+      }
+      if (!m) return;  // the frame's first arrival on another clock: the reference
+      last_ms_[i] = m->ms;
       std::vector<double> y;
       for (const auto& v : last_ms_) y.push_back(v);
       y.push_back(link_p50_);
@@ -173,6 +185,15 @@ void LatencyChart::subscribe(bus::Bus& bus) {
       link_p99_ = m.directions[0].delay_p99_ms;
     }
   });
+}
+
+bool LatencyChart::update() {
+  if (source_clock_ && !titled_) {
+    std::lock_guard lock(arrivals_m_);
+    chart()->SetTitle(chart_title_);
+    titled_ = true;
+  }
+  return ChartRenderer::update();
 }
 
 CeCostChart::CeCostChart(std::string channel)

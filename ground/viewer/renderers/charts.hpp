@@ -10,12 +10,14 @@
 
 #include <array>
 #include <atomic>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include "ground/viewer/latest.hpp"
 #include "ground/viewer/layout.hpp"
 #include "ground/viewer/renderer.hpp"
+#include "tools/latency/source_clock.hpp"
 
 
 namespace aerie::viewer {
@@ -95,16 +97,25 @@ class VoFeatureChart : public ChartRenderer {
 };
 
 // Per-channel latency (receive time - source utime, ms) of the result channels, and the
-// link emulator's achieved delay (LINK_STATS, first direction, p50/p99).
+// link emulator's achieved delay (LINK_STATS, first direction, p50/p99). Messages stamped
+// by another clock (recorded data) follow tools/latency/source_clock.hpp: their latency is
+// measured from their frame's first arrival, and the title says so.
 class LatencyChart : public ChartRenderer {
  public:
   explicit LatencyChart(std::vector<std::string> channels = {"CAM_STEREO", "TRACK", "VO_POSE", "CTRL_CMD"});
   void subscribe(bus::Bus& bus) override;
+  bool update() override;
+  bool source_clock() const { return source_clock_; }
 
  private:
   std::vector<std::string> channels_;
   std::vector<std::atomic<double>> last_ms_;
   std::atomic<double> link_p50_{0}, link_p99_{0};
+  std::mutex arrivals_m_;
+  latency::FrameArrivals arrivals_;
+  std::atomic<bool> source_clock_{false};
+  std::string chart_title_;  // set once by the LCM thread (under source_clock_), read after it
+  bool titled_ = false;
 };
 
 // CE_PROGRESS: best cost per iteration.

@@ -2,7 +2,10 @@
 
 #include "procman/channels.hpp"
 
+#include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkStdString.h>
+#include <vtkTextRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
@@ -176,7 +179,7 @@ void ProcmanPanel::attach(Layout& layout) {
   draws_in(layout.panel);
   actor_ = vtkSmartPointer<vtkTextActor>::New();
   actor_->GetTextProperty()->SetFontFamilyToCourier();
-  actor_->GetTextProperty()->SetFontSize(11);
+  actor_->GetTextProperty()->SetFontSize(10);
   actor_->GetTextProperty()->SetColor(0.85, 0.9, 0.85);
   actor_->GetTextProperty()->SetVerticalJustificationToTop();
   actor_->SetTextScaleModeToNone();
@@ -262,44 +265,103 @@ bool ProcmanPanel::on_key(const std::string& key) {
   return true;
 }
 
+std::string ProcmanPanel::fit(const std::string& line, size_t width) {
+  // Count UTF-8 characters (not continuation bytes).
+  size_t chars = 0, cut = line.size();
+  for (size_t i = 0; i < line.size(); ++i) {
+    if ((static_cast<unsigned char>(line[i]) & 0xC0) == 0x80) continue;
+    if (chars + 1 == width) cut = i;  // where the ellipsis goes if the line is too long
+    if (++chars > width) return line.substr(0, cut) + "\u2026";
+  }
+  return line;
+}
+
 std::string ProcmanPanel::text() const {
   std::lock_guard lock(m_);
   const int64_t now = now_ms();
+  const size_t W = std::max<size_t>(width_chars_, 24);
   std::string s;
-  char line[200];
+  auto add = [&](const std::string& line) { s += fit(line, W) + "\n"; };
+  char line[400];
   for (const auto& [host, dv] : observer_.deputies()) {
-    std::snprintf(line, sizeof line, "host %-8.8s %-4s cpu %5.1f%% mem %6.0f MiB\n", host.c_str(),
+    std::snprintf(line, sizeof line, "host %-8.8s %-4s cpu %5.1f%% mem %6.0f MiB", host.c_str(),
                   observer_.deputy_alive(host, now) ? "ok" : "LOST", 100.0 * dv.info.cpu_load, dv.used_mib());
-    s += line;
+    add(line);
   }
-  if (!observer_.commands().empty()) s += "  command          state       cpu    rss  rst\n";
+  // Columns: "> " name, state (10), cpu (6), rss (6), restarts (3): the name gets what is left, 6..16.
+  const int name_w = static_cast<int>(std::clamp<size_t>(W > 31 ? W - 31 : 0, 6, 16));
   const auto& cmds = observer_.commands();
+  if (!cmds.empty()) {
+    std::snprintf(line, sizeof line, "  %-*s %-10s %6s %6s %3s", name_w, "command", "state", "cpu", "rss", "rst");
+    add(line);
+  }
   for (size_t i = 0; i < cmds.size(); ++i) {
     const auto& c = cmds[i];
-    std::snprintf(line, sizeof line, "%s %-16.16s %-10.10s %5.1f%% %5.0fM %3d\n", i == selected_ % cmds.size() ? ">" : " ",
-                  c.cmd.command_name.c_str(), procman::to_string(observer_.status(c, now)),
+    std::snprintf(line, sizeof line, "%s %-*.*s %-10.10s %5.1f%% %5.0fM %3d", i == selected_ % cmds.size() ? ">" : " ",
+                  name_w, name_w, c.cmd.command_name.c_str(), procman::to_string(observer_.status(c, now)),
                   c.reported ? 100.0 * c.last.cpu_usage : 0.0,
                   c.reported ? static_cast<double>(c.last.mem_rss_bytes) / 1048576.0 : 0.0, c.restarts);
-    s += line;
+    add(line);
   }
-  if (!cmds.empty())
-    s += signer_ ? "  [ ] select   s start/stop (keyed orders)\n"
-                 : "  [ ] select   s start/stop (plain: keyed deputies refuse; --key)\n";
+  if (!cmds.empty()) {
+    add("  [ ] select  s start/stop" + std::string(signer_ ? " (keyed orders)" : ""));
+    if (!signer_) add("  plain orders: keyed deputies refuse (--key)");
+  }
   if (!nodes_.empty()) s += "\nnode          health\n";
   static const char* health[] = {"ok", "WARN", "ERROR"};
   for (const auto& [channel, m] : nodes_) {
-    std::snprintf(line, sizeof line, "%-13.13s %-5s %.30s\n", m.node.c_str(),
+    // The message gets the rest of the line; fit() marks a cut one.
+    std::snprintf(line, sizeof line, "%-13.13s %-5s %s", m.node.c_str(),
                   health[std::min<int>(std::max<int>(m.health, 0), 2)], m.message.c_str());
-    s += line;
+    add(line);
   }
   return s.empty() ? "processes: waiting for PMD_INFO2 and STATUS_*" : s;
 }
 
+size_t ProcmanPanel::measure_chars() const {
+  if (!panel_ || !panel_->GetRenderWindow()) return kDefaultChars;
+  const std::string probe(40, 'M');
+  int bb[4] = {0, 0, 0, 0};
+  vtkTextRenderer* tr = vtkTextRenderer::GetInstance();
+  auto bold = vtkSmartPointer<vtkTextProperty>::New();
+  bold->ShallowCopy(actor_->GetTextProperty());
+  bold->SetBold(true);  // alarm lines are bold: never narrower
+  if (!tr || !tr->GetBoundingBox(bold.Get(), vtkStdString(probe), bb, panel_->GetRenderWindow()->GetDPI()) || bb[1] <= bb[0])
+    return kDefaultChars;
+  const double char_px = static_cast<double>(bb[1] - bb[0] + 1) / static_cast<double>(probe.size());
+  return static_cast<size_t>(std::max(0.0, room_px() / char_px));
+}
+
+double ProcmanPanel::room_px() const {
+  if (!panel_ || !panel_->GetRenderWindow()) return 0;
+  double vp[4];
+  panel_->GetViewport(vp);
+  const double x0 = actor_->GetPositionCoordinate()->GetValue()[0];  // normalized viewport
+  return (vp[2] - vp[0]) * panel_->GetRenderWindow()->GetSize()[0] * (1.0 - x0 - 0.01);
+}
+
+double ProcmanPanel::text_width_px() const {
+  if (!panel_ || !panel_->GetRenderWindow()) return 0;
+  vtkTextRenderer* tr = vtkTextRenderer::GetInstance();
+  double widest = 0;
+  std::vector<vtkTextActor*> actors{actor_.Get()};
+  for (const auto& a : alert_actors_) actors.push_back(a.Get());
+  for (auto* a : actors) {
+    if (!a->GetInput() || !*a->GetInput()) continue;
+    int bb[4] = {0, 0, 0, 0};
+    if (tr->GetBoundingBox(a->GetTextProperty(), vtkStdString(a->GetInput()), bb, panel_->GetRenderWindow()->GetDPI()))
+      widest = std::max(widest, static_cast<double>(bb[1] - bb[0] + 1));
+  }
+  return widest;
+}
+
 bool ProcmanPanel::update() {
+  const size_t chars = measure_chars();  // the window may have been resized
   {
     std::lock_guard lock(m_);
-    if (version_ == seen_) return false;
+    if (version_ == seen_ && chars == width_chars_) return false;
     seen_ = version_;
+    width_chars_ = chars;
   }
   // Each alert line is its own actor (its own colour) at the panel's corner, pushed down by
   // blank lines; the processes follow below them.
@@ -320,7 +382,7 @@ bool ProcmanPanel::update() {
     p->SetBold(lines[i].alarm);
     if (lines[i].alarm) p->SetColor(1.0, 0.25, 0.2);
     else p->SetColor(0.55, 0.95, 0.55);
-    alert_actors_[i]->SetInput((pad + lines[i].text).c_str());
+    alert_actors_[i]->SetInput((pad + fit(lines[i].text, width_chars_)).c_str());
     pad += " \n";
   }
   for (size_t i = lines.size(); i < alert_actors_.size(); ++i) alert_actors_[i]->SetInput("");

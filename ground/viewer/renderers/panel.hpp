@@ -18,6 +18,7 @@
 #include <bot_procman/orders2_t.hpp>
 #include <vtkSmartPointer.h>
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -42,7 +43,17 @@ class ProcmanPanel : public Renderer {
   bool update() override;
   // '[' / ']' select the previous / next command, 's' starts or stops it.
   bool on_key(const std::string& key) override;
+  // The panel's text, `width_chars()` wide (long names and messages abbreviated).
   std::string text() const;
+  // Characters of the panel's font that fit its viewport, measured (vtkTextRenderer) at every
+  // update; kDefaultChars before the first.
+  size_t width_chars() const { return width_chars_; }
+  static constexpr size_t kDefaultChars = 46;
+  // The drawn text's widest line and the room for it, in pixels (render thread).
+  double text_width_px() const;
+  double room_px() const;
+  // `line` cut to `width` characters (UTF-8 aware), the last one an ellipsis when it was longer.
+  static std::string fit(const std::string& line, size_t width);
   // A line drawn above the processes; `alarm` draws it in red.
   struct Line {
     std::string text;
@@ -85,6 +96,8 @@ class ProcmanPanel : public Renderer {
   vtkSmartPointer<vtkTextActor> actor_;
   std::vector<vtkSmartPointer<vtkTextActor>> alert_actors_;  // one per line, all at actor_'s corner
   vtkRenderer* panel_ = nullptr;
+  std::atomic<size_t> width_chars_{kDefaultChars};
+  size_t measure_chars() const;
 };
 
 }  // namespace aerie::viewer

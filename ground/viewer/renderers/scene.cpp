@@ -7,6 +7,7 @@
 #include <vtkCellArray.h>
 #include <vtkFloatArray.h>
 #include <vtkLookupTable.h>
+#include <vtkMatrix4x4.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -25,6 +26,7 @@
 
 #include "common/spherical/spherical_message.hpp"
 #include "ground/map/octomap_message.hpp"
+#include "common/util/time.hpp"
 #include "ground/viewer/layout.hpp"
 #include "ground/viewer/voxel_mesh.hpp"
 
@@ -61,7 +63,167 @@ void set_frustum(vtkPolyData* poly, const geometry::SE3& T) {
   poly->Modified();
 }
 
+// Colours the map's surface by height in the display frame (z up) of T_display_map.
+void colour_by_height(vtkActor* actor, const geometry::SE3& T_display_map) {
+  auto* mapper = vtkPolyDataMapper::SafeDownCast(actor->GetMapper());
+  auto* poly = vtkPolyData::SafeDownCast(mapper->GetInput());
+  if (!poly || !poly->GetPoints() || poly->GetNumberOfPoints() == 0) return;
+  const Eigen::Vector3d up = T_display_map.rotation().conjugate() * Eigen::Vector3d::UnitZ();  // in the map
+  const double z0 = T_display_map.translation().z();
+  auto height = vtkSmartPointer<vtkFloatArray>::New();
+  height->SetName("height");
+  height->SetNumberOfValues(poly->GetNumberOfPoints());
+  double lo = 1e300, hi = -1e300;
+  for (vtkIdType i = 0; i < poly->GetNumberOfPoints(); ++i) {
+    double p[3];
+    poly->GetPoint(i, p);
+    const double z = up.dot(Eigen::Vector3d(p[0], p[1], p[2])) + z0;
+    height->SetValue(i, static_cast<float>(z));
+    lo = std::min(lo, z);
+    hi = std::max(hi, z);
+  }
+  poly->GetPointData()->SetScalars(height);
+  mapper->SetScalarRange(lo, std::max(hi, lo + 1e-3));
+}
+
 }  // namespace
+
+// ---------------------------------------------------------------- world frame
+void InWorld::place(vtkProp3D* prop, const geometry::SE3& T) {
+  if (!prop) return;
+  auto m = vtkSmartPointer<vtkMatrix4x4>::New();
+  const Eigen::Matrix4d M = T.matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m->SetElement(r, c, M(r, c));
+  prop->SetUserMatrix(m);
+}
+
+WorldFrameRenderer::WorldFrameRenderer(Options options)
+    : Renderer("world"), options_(std::move(options)), vo_(options_.max_poses), gt_(options_.max_poses) {
+  if (!(options_.align_period_s > 0)) throw std::invalid_argument("viewer: the GT alignment period must be > 0 s");
+  if (options_.imu_samples == 0) throw std::invalid_argument("viewer: gravity needs at least one IMU sample");
+}
+
+void WorldFrameRenderer::subscribe(bus::Bus& bus) {
+  bus.subscribe<aerie::pose_t>(options_.vo_channel, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
+    if (m.status == aerie::pose_t::RESET) {
+      vo_.clear();
+      ++resets_;
+    }
+    vo_.push({m.utime, geometry::SE3::from_wxyz(m.orientation, m.position)});
+  });
+  bus.subscribe<aerie::gt_pose_t>(options_.gt_channel, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
+    gt_.push({m.utime, geometry::SE3::from_wxyz(m.orientation, m.position)});
+  });
+  bus.subscribe<aerie::imu_t>(options_.imu_channel, [this](const aerie::imu_t& m, const bus::ReceiveInfo&) {
+    std::lock_guard lock(imu_m_);
+    if (imu_.size() < options_.imu_samples)
+      imu_.emplace_back(m.linear_acceleration[0], m.linear_acceleration[1], m.linear_acceleration[2]);
+  });
+}
+
+void WorldFrameRenderer::attach(Layout& layout) {
+  draws_in(layout.scene);
+  label_ = vtkSmartPointer<vtkTextActor>::New();
+  label_->GetTextProperty()->SetFontSize(12);
+  label_->GetTextProperty()->SetColor(0.9, 0.9, 0.75);
+  label_->GetTextProperty()->SetVerticalJustificationToTop();
+  label_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  label_->GetPositionCoordinate()->SetValue(0.01, 0.98);
+  label_->SetInput(label().c_str());
+  layout.scene->AddActor2D(label_);
+  scene_ = layout.scene;
+}
+
+std::string WorldFrameRenderer::label() const {
+  std::string gt = alignment_ ? alignment_->label() : gt_buf_.empty() ? "GT: none" : "GT: not aligned yet (in its own world)";
+  return gravity_label(gravity_) + "\n" + gt;
+}
+
+bool WorldFrameRenderer::on_key(const std::string& key) {
+  if (key != "g") return false;
+  align_now_ = true;
+  return true;
+}
+
+bool WorldFrameRenderer::update() {
+  const bool vo_new = vo_.snapshot_if_newer(vo_seen_, vo_buf_);
+  const bool gt_new = gt_.snapshot_if_newer(gt_seen_, gt_buf_);
+  const geometry::SE3 old_vo = T_D_vo_, old_gt = T_D_gt_;
+  bool moved_view = false;
+  if (resets_ != resets_seen_) {  // a new VO world: decide again
+    resets_seen_ = resets_;
+    gravity_ = GravitySource::None;
+    alignment_.reset();
+    viewed_.reset();
+    T_D_vo_ = geometry::SE3();
+  }
+  // Gravity: the first VO pose with a ground-truth pose of the same frame, else the IMU.
+  if (gravity_ != GravitySource::FirstGtPose && !vo_buf_.empty() && !gt_buf_.empty()) {
+    for (const auto& v : vo_buf_) {
+      const auto g = std::find_if(gt_buf_.begin(), gt_buf_.end(), [&](const StampedPose& p) {
+        return std::llabs(p.utime - v.utime) <= 5000;  // the same frame (5 ms)
+      });
+      if (g == gt_buf_.end()) continue;
+      T_D_vo_ = frame_from_first_gt_pose(g->T_world_camera, v.T_world_camera);
+      gravity_ = GravitySource::FirstGtPose;
+      break;
+    }
+  }
+  if (gravity_ == GravitySource::None && !vo_buf_.empty()) {
+    std::vector<Eigen::Vector3d> imu;
+    {
+      std::lock_guard lock(imu_m_);
+      if (imu_.size() >= options_.imu_samples) imu = imu_;
+    }
+    if (!imu.empty()) {
+      try {
+        T_D_vo_ = geometry::SE3(gravity_rotation(imu, options_.T_body_cam, vo_buf_.front().T_world_camera),
+                                Eigen::Vector3d::Zero());
+        gravity_ = GravitySource::Imu;
+      } catch (const std::invalid_argument& e) {
+        spdlog::warn("viewer: no gravity from {}: {}", options_.imu_channel, e.what());
+        std::lock_guard lock(imu_m_);
+        imu_.clear();  // the next samples, perhaps at rest
+      }
+    }
+  }
+  // Ground truth in the estimate's frame, every align_period_s (message handling never waits).
+  const double now = util::mono_ms() / 1000.0;
+  unaligned_ = unaligned_ || vo_new || gt_new;  // poses came since the last alignment
+  if ((unaligned_ && now - last_align_s_ >= options_.align_period_s) || align_now_) {
+    align_now_ = unaligned_ = false;
+    last_align_s_ = now;
+    eval::Trajectory gt, vo;
+    for (const auto& p : gt_buf_) gt.push_back(static_cast<double>(p.utime) * 1e-6, p.T_world_camera);
+    for (const auto& p : vo_buf_) vo.push_back(static_cast<double>(p.utime) * 1e-6, p.T_world_camera);
+    if (auto a = align_ground_truth(gt, vo, 0.005)) alignment_ = a;
+  }
+  T_D_gt_ = alignment_ ? T_D_vo_ * alignment_->T_vo_gt : geometry::SE3();
+  auto same = [](const geometry::SE3& a, const geometry::SE3& b) {
+    return a.translation() == b.translation() && a.rotation().coeffs() == b.rotation().coeffs();
+  };
+  const bool moved = !same(old_vo, T_D_vo_) || !same(old_gt, T_D_gt_);
+  if (moved) ++version_;
+  if (options_.frame_vehicle && viewed_ != gravity_ && scene_ && !vo_buf_.empty()) {
+    // Once per display frame: look at the vehicle's start from behind-left and above
+    // (GridRenderer's direction), 8 m away, rather than at the whole grid.
+    viewed_ = gravity_;
+    const Eigen::Vector3d c = T_D_vo_ * vo_buf_.front().T_world_camera.translation();
+    const Eigen::Vector3d eye = c + 8.0 * Eigen::Vector3d(-0.9, -1.3, 0.9).normalized();
+    vtkCamera* cam = scene_->GetActiveCamera();
+    cam->SetFocalPoint(c.x(), c.y(), c.z());
+    cam->SetPosition(eye.x(), eye.y(), eye.z());
+    cam->SetViewUp(0, 0, 1);
+    scene_->ResetCameraClippingRange();
+    moved_view = true;
+  }
+  const std::string text = label();
+  const bool relabelled = text != shown_label_;
+  if (relabelled && label_) label_->SetInput(text.c_str());
+  shown_label_ = text;
+  return moved || relabelled || moved_view;
+}
 
 // ---------------------------------------------------------------- grid
 GridRenderer::GridRenderer(double half_size_m, double spacing_m)
@@ -131,7 +293,14 @@ void PoseRenderer::attach(Layout& layout) {
 }
 
 bool PoseRenderer::update() {
-  if (!poses_.snapshot_if_newer(seen_, buffer_)) return false;
+  if (world_changed()) {
+    const geometry::SE3 T = gt_ ? from_gt() : from_vo();
+    place(path_, T);
+    place(frustum_, T);
+    if (!poses_.snapshot_if_newer(seen_, buffer_)) return true;
+  } else if (!poses_.snapshot_if_newer(seen_, buffer_)) {
+    return false;
+  }
   auto pts = vtkSmartPointer<vtkPoints>::New();
   auto line = vtkSmartPointer<vtkCellArray>::New();
   line->InsertNextCell(static_cast<vtkIdType>(buffer_.size()));
@@ -144,7 +313,7 @@ bool PoseRenderer::update() {
   poly_of(path_)->Modified();
   if (!buffer_.empty()) set_frustum(poly_of(frustum_), buffer_.back().T_world_camera);
   shown_ = buffer_.size();
-  if (!camera_fitted_ && shown_ > 1) {
+  if (!camera_fitted_ && shown_ > 1 && !world_frames_the_view()) {
     scene_->ResetCamera();
     camera_fitted_ = true;
   }
@@ -185,8 +354,10 @@ void DepthCloudRenderer::attach(Layout& layout) {
 }
 
 bool DepthCloudRenderer::update() {
+  const bool moved = world_changed();
+  if (moved) place(actor_, from_vo());
   std::vector<Eigen::Vector3f> pts;
-  if (!cloud_.take_if_newer(seen_, pts)) return false;
+  if (!cloud_.take_if_newer(seen_, pts)) return moved;
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToFloat();
   points->SetNumberOfPoints(static_cast<vtkIdType>(pts.size()));
@@ -348,6 +519,11 @@ bool OctomapRenderer::update() {
     std::lock_guard lock(map_->m);
     surface.swap(map_->ready);
   }
+  if (world_changed()) {
+    place(actor_, from_vo());
+    colour_by_height(actor_, from_vo());
+    if (!surface) return true;
+  }
   if (!surface) return false;
   const VoxelMesh& mesh = surface->mesh;
   auto points = vtkSmartPointer<vtkPoints>::New();
@@ -373,7 +549,7 @@ bool OctomapRenderer::update() {
   poly->GetPointData()->SetScalars(height);
   auto* mapper = vtkPolyDataMapper::SafeDownCast(actor_->GetMapper());
   mapper->SetInputData(poly);
-  mapper->SetScalarRange(surface->zmin, surface->zmax);
+  colour_by_height(actor_, from_vo());  // height in the display frame (z up), not in VO's world
   shown_ = mesh.voxels;
   quads_ = mesh.quads.size();
   shown_coarsening_ = surface->coarsening_shown;
@@ -400,10 +576,10 @@ void TargetPoseRenderer::subscribe(bus::Bus& bus) {
   bus.subscribe<aerie::target_pose_t>(channel_,
                                       [this](const aerie::target_pose_t& m, const bus::ReceiveInfo&) { target_.set(m); });
   bus.subscribe<aerie::pose_t>(pose_channel_, [this](const aerie::pose_t& m, const bus::ReceiveInfo&) {
-    camera_.set(geometry::SE3::from_wxyz(m.orientation, m.position));
+    camera_.set({geometry::SE3::from_wxyz(m.orientation, m.position), false});
   });
   bus.subscribe<aerie::gt_pose_t>(gt_pose_channel_, [this](const aerie::gt_pose_t& m, const bus::ReceiveInfo&) {
-    camera_.set(geometry::SE3::from_wxyz(m.orientation, m.position));
+    camera_.set({geometry::SE3::from_wxyz(m.orientation, m.position), true});
   });
 }
 
@@ -422,8 +598,8 @@ void TargetPoseRenderer::attach(Layout& layout) {
 
 bool TargetPoseRenderer::update() {
   aerie::target_pose_t t;
-  geometry::SE3 c;
-  bool changed = false;
+  Camera c;
+  bool changed = world_changed();
   if (target_.take_if_newer(seen_target_, t)) {
     current_ = t;
     changed = true;
@@ -433,7 +609,10 @@ bool TargetPoseRenderer::update() {
     changed = true;
   }
   if (!changed || !current_ || !current_camera_) return false;
-  const Eigen::Vector3d w = *current_camera_ * Eigen::Vector3d(current_->position[0], current_->position[1], current_->position[2]);
+  const geometry::SE3 T_display_cam =
+      (current_camera_->ground_truth ? from_gt() : from_vo()) * current_camera_->T;
+  const Eigen::Vector3d w =
+      T_display_cam * Eigen::Vector3d(current_->position[0], current_->position[1], current_->position[2]);
   actor_->SetPosition(w.x(), w.y(), w.z());
   actor_->SetVisibility(enabled());
   return true;

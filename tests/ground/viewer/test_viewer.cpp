@@ -10,6 +10,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -31,6 +33,7 @@
 #include "common/util/time.hpp"
 #include "ground/map/octomap_message.hpp"
 #include "procman/channels.hpp"
+#include "ground/viewer/keys.hpp"
 #include "ground/viewer/renderers/charts.hpp"
 #include "ground/viewer/renderers/panel.hpp"
 #include "ground/viewer/renderers/scene.hpp"
@@ -186,6 +189,37 @@ aerie::autopilot_state_t autopilot_state(bool signing, int8_t link = aerie::auto
   s.last_command = "MAV_CMD_COMPONENT_ARM_DISARM";
   s.last_result = "ACCEPTED";
   return s;
+}
+
+// A deputy's PMD_INFO2 with commands (name, pid: 0 = stopped, run id); sheriff ids 1 for the
+// running ones, 2 for the stopped.
+struct DeputyCommand {
+  const char* name;
+  int pid, runid;
+};
+bot_procman::info2_t deputy_report(const char* host, float cpu_load, const std::vector<DeputyCommand>& cmds,
+                                   float cmd_cpu, int64_t cmd_rss) {
+  bot_procman::info2_t info{};
+  info.utime = util::wall_utime();
+  info.host = host;
+  info.cpu_load = cpu_load;
+  info.phys_mem_total_bytes = 8LL << 30;
+  info.phys_mem_free_bytes = 4LL << 30;
+  for (const auto& d : cmds) {
+    bot_procman::deputy_cmd2_t c{};
+    c.cmd.command_name = d.name;
+    c.cmd.exec_str = std::string("aerie-") + d.name;
+    c.cmd.num_options = 0;
+    c.pid = d.pid;
+    c.actual_runid = d.runid;
+    c.sheriff_id = d.pid ? 1 : 2;
+    c.cpu_usage = cmd_cpu;
+    c.mem_rss_bytes = cmd_rss;
+    info.cmds.push_back(c);
+  }
+  info.ncmds = static_cast<int32_t>(info.cmds.size());
+  info.num_options = 0;
+  return info;
 }
 
 std::string joined(const std::vector<ProcmanPanel::Line>& lines) {
@@ -422,26 +456,8 @@ TEST_F(Fixture, SurvivesMalformedMessagesAndChannelsThatStopAndRestart) {
 
 TEST_F(Fixture, ProcmanPanelShowsDeputyCommandsAndStartsOrStopsTheSelectedOne) {
   make();
-  bot_procman::info2_t info{};
-  info.utime = util::wall_utime();
-  info.host = "air";
-  info.cpu_load = 0.25f;
-  info.phys_mem_total_bytes = 8LL << 30;
-  info.phys_mem_free_bytes = 4LL << 30;
-  for (auto [name, pid, runid] : {std::tuple{"capture", 4242, 1}, std::tuple{"vo", 0, 0}}) {
-    bot_procman::deputy_cmd2_t c{};
-    c.cmd.command_name = name;
-    c.cmd.exec_str = std::string("aerie-") + name;
-    c.cmd.num_options = 0;
-    c.pid = pid;
-    c.actual_runid = runid;
-    c.sheriff_id = pid ? 1 : 2;
-    c.cpu_usage = 0.5f;
-    c.mem_rss_bytes = 64LL << 20;
-    info.cmds.push_back(c);
-  }
-  info.ncmds = 2;
-  info.num_options = 0;
+  const bot_procman::info2_t info =
+      deputy_report("air", 0.25f, {{"capture", 4242, 1}, {"vo", 0, 0}}, 0.5f, 64LL << 20);
   std::vector<bot_procman::orders2_t> orders;
   bus.subscribe<bot_procman::orders2_t>("PMD_ORDERS2", [&](const bot_procman::orders2_t& o, const bus::ReceiveInfo&) {
     orders.push_back(o);
@@ -686,4 +702,125 @@ TEST(TrackerCycle, StartsWithTheNodesDefaultAndReachesEveryTracker) {
   EXPECT_EQ(cycle.size(), every.size());
   for (const auto& name : every) EXPECT_EQ(std::count(cycle.begin(), cycle.end(), name), 1) << name;
   EXPECT_EQ(std::count(cycle.begin(), cycle.end(), "dcf"), 1);
+}
+
+// Issue 49: the process panel's columns were cut at 1280 px. Its text is laid out for the
+// width measured in its font: every drawn line fits, long names and messages are abbreviated.
+TEST_F(Fixture, ProcessPanelFitsItsPaneAt1280Pixels) {
+  make(1280, 800);
+  auto* panel = dynamic_cast<ProcmanPanel*>(viewer->find("processes"));
+  ASSERT_NE(panel, nullptr);
+  bus.publish("PMD_INFO2", deputy_report("companion-computer", 0.5f,
+                                         {{"stereo-visual-odometry-front", 4242, 1}, {"capture", 0, 1}}, 1.0f,
+                                         1234LL << 20));
+  aerie::process_status_t st{};
+  st.utime = util::wall_utime();
+  st.node = "vo";
+  st.health = aerie::process_status_t::WARN;
+  st.message = "queue overflowed 12 times in the last second: 3 pairs dropped; sequence gaps 4";
+  st.ncounters = st.ntimings = 0;
+  bus.publish("STATUS_VO", st);
+  bus.publish("STATUS_LINK_AIR", door_status("air", kFp));
+  bus.publish("AUTOPILOT_STATE", autopilot_state(true));
+  ASSERT_TRUE(render_until([&] { return panel->text().find("vo ") != std::string::npos && panel->alerts().size() >= 3; }))
+      << panel->text();
+  viewer->render_frame();
+  const std::string text = panel->text();
+  EXPECT_GE(panel->width_chars(), 40u) << "the panel at 1280 px holds fewer characters than expected";
+  EXPECT_GT(panel->room_px(), 250);
+  EXPECT_GT(panel->text_width_px(), 100);
+  EXPECT_LE(panel->text_width_px(), panel->room_px()) << text;
+  // Every line within the measured width; what was too long ends with an ellipsis.
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    EXPECT_EQ(ProcmanPanel::fit(line, panel->width_chars()), line) << line;
+  EXPECT_NE(text.find("stereo-visual-od"), std::string::npos) << text;  // abbreviated, still recognisable
+  EXPECT_NE(text.find("queue overflowed"), std::string::npos) << text;
+  EXPECT_NE(text.find("\u2026"), std::string::npos) << text;
+  // fit() counts characters, not bytes, and marks a cut line.
+  EXPECT_EQ(ProcmanPanel::fit("abcdef", 4), "abc\u2026");
+  EXPECT_EQ(ProcmanPanel::fit("ab\u2026cd", 5), "ab\u2026cd");
+  EXPECT_EQ(ProcmanPanel::fit("abcd", 4), "abcd");
+}
+
+// Issue 49: the overlay's key list disagreed with docs/viewer.md. The overlay lists every key of
+// keys.hpp (test_viewer_frames checks the doc's "Keys" table against it), and the doc's renderer
+// numbers are the ones the keys 1-9 toggle.
+TEST_F(Fixture, HelpOverlayListsEveryKeyAndTheDocsRendererNumbersAreTheKeys) {
+  make();
+  const std::string help = viewer->help_text();
+  for (const auto& k : kKeys)
+    EXPECT_NE(help.find(std::string(k.key) + ": " + std::string(k.overlay)), std::string::npos) << k.key << "\n" << help;
+  std::ifstream in(AERIE_SOURCE_DIR "/docs/viewer.md");
+  ASSERT_TRUE(in);
+  size_t numbered = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.size() < 8 || line[0] != '|' || line[2] < '1' || line[2] > '9' || line[3] != ' ') continue;
+    const size_t n = static_cast<size_t>(line[2] - '0'), a = line.find('`'), b = line.find('`', a + 1);
+    ASSERT_NE(b, std::string::npos) << line;
+    ASSERT_LE(n, viewer->renderers().size());
+    EXPECT_EQ(line.substr(a + 1, b - a - 1), viewer->renderers()[n - 1]->name()) << "docs/viewer.md renderer " << n;
+    ++numbered;
+  }
+  EXPECT_EQ(numbered, 9u);
+}
+
+// Issue 49: VO's world is the first camera's frame (z forward). With a ground truth, the scene is
+// the ground truth's world (z up) and the ground truth is drawn aligned to the estimate.
+TEST_F(Fixture, SceneIsGravityAlignedFromTheFirstGroundTruthPoseAndTheGroundTruthAligned) {
+  make();
+  auto* world = dynamic_cast<WorldFrameRenderer*>(viewer->find("world"));
+  ASSERT_NE(world, nullptr);
+  EXPECT_EQ(world->gravity(), GravitySource::None);
+  // A level camera looking along world x, 1.2 m up, flying a curve; VO starts at identity.
+  Eigen::Matrix3d R_w_c0;
+  R_w_c0.col(0) = Eigen::Vector3d(0, -1, 0);
+  R_w_c0.col(1) = Eigen::Vector3d(0, 0, -1);
+  R_w_c0.col(2) = Eigen::Vector3d(1, 0, 0);
+  const geometry::SE3 T_w_c0(R_w_c0, Eigen::Vector3d(2, 3, 1.2));
+  const int64_t t0 = 1'403'715'273'262'142;  // dataset time
+  std::vector<geometry::SE3> gt;
+  for (int i = 0; i < 40; ++i) {
+    const double s = 0.1 * i;
+    gt.push_back(geometry::SE3(Eigen::Matrix3d(Eigen::AngleAxisd(0.2 * s, Eigen::Vector3d::UnitZ())) * R_w_c0,
+                               Eigen::Vector3d(2 + s, 3 + 0.5 * std::sin(s), 1.2 + 0.2 * s)));
+  }
+  for (int i = 0; i < 40; ++i) {
+    const int64_t t = t0 + i * 50'000;
+    aerie::gt_pose_t g{};
+    g.utime = t;
+    g.frame_id = "vicon";
+    gt[i].to_wxyz(g.orientation);
+    for (int k = 0; k < 3; ++k) g.position[k] = gt[i].translation()[k];
+    bus.publish("GT_POSE", g);
+    const geometry::SE3 vo = T_w_c0.inverse() * gt[i];
+    aerie::pose_t p{};
+    p.utime = t;
+    vo.to_wxyz(p.orientation);
+    for (int k = 0; k < 3; ++k) p.position[k] = vo.translation()[k];
+    bus.publish("VO_POSE", p);
+  }
+  // 'g' aligns at once (else every --align-period seconds while poses come).
+  ASSERT_TRUE(render_until([&] {
+    viewer->on_key("g");
+    viewer->render_frame();
+    return world->alignment() && world->alignment()->pairs == 40;
+  })) << world->label();
+  EXPECT_EQ(world->gravity(), GravitySource::FirstGtPose);
+  // The estimate drawn where the ground truth is: z up, on the grid.
+  const geometry::SE3 vo_last = T_w_c0.inverse() * gt.back();
+  EXPECT_LT((world->display_from_vo() * vo_last.translation() - gt.back().translation()).norm(), 1e-9);
+  EXPECT_LT((world->display_from_gt() * gt.back().translation() - gt.back().translation()).norm(), 1e-6);
+  EXPECT_LT(world->alignment()->ate_m, 1e-6);
+  EXPECT_NE(world->label().find("gravity: first GT pose"), std::string::npos) << world->label();
+  EXPECT_NE(world->label().find("GT aligned: SE(3), 40 pairs, ATE 0.000 m"), std::string::npos) << world->label();
+  // Dataset stamps: the latency chart measures from the frame's arrival, not from 2014.
+  auto* latency = dynamic_cast<LatencyChart*>(viewer->find("chart-latency"));
+  ASSERT_NE(latency, nullptr);
+  aerie::pose_t cam{};
+  cam.utime = t0 + 10'000'000;
+  cam.orientation[0] = 1;
+  bus.publish("CAM_STEREO", cam);
+  bus.publish("VO_POSE", cam);
+  ASSERT_TRUE(render_until([&] { return latency->source_clock(); }));
 }

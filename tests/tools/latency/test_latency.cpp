@@ -175,3 +175,85 @@ TEST(LatencyTool, ReadsALogAndWritesCsvAndJson) {
   EXPECT_THROW(procman::testbed::run({(test::binary_dir() / "bin" / "aerie-latency").string(), "/nonexistent.lcm"}),
                std::runtime_error);
 }
+
+// Recorded data (source_clock.hpp): EuRoC stamps its frames with its own 2014 clock. The
+// camera's arrival is the reference; downstream channels and hops are measured from it.
+TEST(LatencyAnalysis, DatasetStampedMessagesAreMeasuredFromTheFramesFirstArrival) {
+  const int64_t kDataset = 1'403'715'273'262'142;  // EuRoC V1_01 (2014), µs
+  LatencyAnalysis a;
+  for (int i = 0; i < 20; ++i) {
+    const int64_t frame = kDataset + i * 50'000, arrival = kT0 + i * 50'000;
+    const auto cam = bytes(pose(frame)), vo = bytes(pose(frame)), ctl = bytes(pose(frame));
+    a.add("CAM_STEREO", arrival, cam.data(), cam.size());
+    a.add("VO_POSE", arrival + 1000 * (10 + i % 5), vo.data(), vo.size());  // 10..14 ms after the frame
+    a.add("CTRL_CMD", arrival + 30'000, ctl.data(), ctl.size());
+    // aerie-vo's heartbeat: received 2 ms after the camera's arrival, published 11 ms later.
+    const auto st = bytes(status("vo", frame, arrival + 2000, arrival + 13'000));
+    a.add("STATUS_VO", arrival + 40'000, st.data(), st.size());
+  }
+  const auto ch = a.channels();
+  ASSERT_EQ(ch.size(), 4u);  // CAM_STEREO, CTRL_CMD, STATUS_VO, VO_POSE
+  EXPECT_EQ(ch[0].channel, "CAM_STEREO");
+  EXPECT_EQ(ch[0].other_clock, 20);
+  EXPECT_EQ(ch[0].references, 20);         // the reference: no latency of its own
+  EXPECT_EQ(ch[0].latency_ms.count, 0);
+  EXPECT_EQ(ch[1].channel, "CTRL_CMD");
+  EXPECT_EQ(ch[1].latency_ms.count, 20);
+  EXPECT_DOUBLE_EQ(ch[1].latency_ms.max, 30.0);
+  EXPECT_EQ(ch[1].reference, "CAM_STEREO");
+  EXPECT_EQ(ch[3].channel, "VO_POSE");
+  EXPECT_EQ(ch[3].other_clock, 20);
+  EXPECT_EQ(ch[3].latency_ms.count, 20);
+  EXPECT_DOUBLE_EQ(ch[3].latency_ms.min, 10.0);
+  EXPECT_DOUBLE_EQ(ch[3].latency_ms.median, 12.0);
+  EXPECT_DOUBLE_EQ(ch[3].latency_ms.max, 14.0);
+  EXPECT_EQ(ch[3].negative, 0);
+  const auto hops = a.hops();
+  ASSERT_EQ(hops.size(), 1u);
+  EXPECT_TRUE(hops[0].source_clock);
+  EXPECT_EQ(hops[0].input_ms.count, 20);
+  EXPECT_DOUBLE_EQ(hops[0].input_ms.median, 2.0);
+  EXPECT_DOUBLE_EQ(hops[0].processing_ms.median, 11.0);
+  EXPECT_DOUBLE_EQ(hops[0].age_ms.max, 13.0);
+  const std::string table = format_table(ch, hops);
+  EXPECT_NE(table.find("latency from the frame's first arrival on CAM_STEREO"), std::string::npos) << table;
+  EXPECT_EQ(table.find("e+"), std::string::npos) << table;  // never a latency of years
+}
+
+TEST(LatencyAnalysis, WallStampedMessagesAreReceiveMinusUtimeAsBefore) {
+  // The same chain live: stamps on the wall clock, so the camera has a latency of its own.
+  LatencyAnalysis a;
+  for (int i = 0; i < 10; ++i) {
+    const int64_t frame = kT0 + i * 50'000;
+    const auto cam = bytes(pose(frame)), vo = bytes(pose(frame));
+    a.add("CAM_STEREO", frame + 4000, cam.data(), cam.size());
+    a.add("VO_POSE", frame + 16'000, vo.data(), vo.size());
+  }
+  const auto ch = a.channels();
+  ASSERT_EQ(ch.size(), 2u);
+  EXPECT_EQ(ch[0].other_clock + ch[0].references + ch[1].other_clock, 0);
+  EXPECT_DOUBLE_EQ(ch[0].latency_ms.median, 4.0);
+  EXPECT_DOUBLE_EQ(ch[1].latency_ms.median, 16.0);
+  EXPECT_EQ(ch[1].reference, "");
+}
+
+TEST(SourceClock, TheRuleAtItsBoundary) {
+  FrameArrivals arrivals;
+  EXPECT_TRUE(on_receive_clock(kT0, kT0 + kOtherClockUs));
+  EXPECT_FALSE(on_receive_clock(kT0, kT0 + kOtherClockUs + 1));
+  EXPECT_FALSE(on_receive_clock(kT0 + kOtherClockUs + 1, kT0));
+  // Another clock: the first arrival is the reference, later ones are measured from it.
+  EXPECT_FALSE(measure(arrivals, "CAM_STEREO", 42, kT0));
+  const auto m = measure(arrivals, "VO_POSE", 42, kT0 + 7500);
+  ASSERT_TRUE(m);
+  EXPECT_TRUE(m->source_clock);
+  EXPECT_DOUBLE_EQ(m->ms, 7.5);
+  EXPECT_EQ(m->reference, "CAM_STEREO");
+  // Old frames are forgotten beyond the capacity.
+  FrameArrivals small(2);
+  small.note(1, kT0, "A");
+  small.note(2, kT0, "A");
+  small.note(3, kT0, "A");
+  EXPECT_EQ(small.find(1), nullptr);
+  ASSERT_NE(small.find(3), nullptr);
+}
