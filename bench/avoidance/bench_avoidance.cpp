@@ -2,7 +2,7 @@
 // simulator, steered by aerie-control on a chosen heading source, one row per run.
 //   aerie-bench-avoidance --runs N --seed S --speed M_S --source gt|vo|vio
 //                         --controller FILE_OR_NAME --out DIR
-// Each run flies tools/avoidance (config/avoidance.yaml) in lock-step, so a row depends on
+// Each run flies loop/avoidance.hpp (config/avoidance.yaml) in lock-step, so a row depends on
 // its seed alone. Lists (--speed 0.4,0.6,0.8 --source gt,vo,vio --controller sf,sfmf) run
 // every combination. Writes DIR/avoidance.csv and DIR/trajectories.csv and prints one
 // summary line per configuration; DIR/*.png when bench/avoidance/plot_avoidance.py runs.
@@ -20,7 +20,7 @@
 
 #include "common/flc/flc_io.hpp"
 #include "bench/seeded_runs.hpp"
-#include "tools/avoidance/avoidance_run.hpp"
+#include "loop/avoidance.hpp"
 #include "tools/study/note.hpp"
 #include "tools/study/study.hpp"
 
@@ -30,7 +30,7 @@ namespace {
 
 struct Setup {
   double speed = 0.6;
-  avoidance::Source source = avoidance::Source::kVio;
+  loop::avoidance::Source source = loop::avoidance::Source::kVio;
   std::string controller;
   bool vibration = true;
 };
@@ -42,7 +42,7 @@ struct Share {
   double heading_rmse_deg = 0, estimate_rmse_deg = 0, min_wall_distance_m = 0, wall_s = 0, sim_s = 0;
 };
 
-std::string note_of(const avoidance::RunResult& r) {
+std::string note_of(const loop::avoidance::RunResult& r) {
   study::NoteWriter n;
   n.integer(r.entered_danger).integer(r.collided).integer(r.completed);
   n.real(r.heading_rmse_deg).real(r.estimate_rmse_deg).real(r.min_wall_distance_m).real(r.wall_s).real(r.sim_s);
@@ -86,15 +86,15 @@ std::string summary(const Setup& s, const std::vector<Share>& runs) {
                 "%-4s %-8s %.1f m/s vib %-3s: %d/%zu completed, steady heading RMSE %.2f deg (%d settled), heading estimate "
                 "RMSE %.2f deg, %d in the dangerous area, %d collisions, closest to the wall %.2f m, %.2f s wall per "
                 "simulated s",
-                avoidance::source_name(s.source), s.controller.c_str(), s.speed, s.vibration ? "on" : "off", completed, runs.size(),
+                loop::avoidance::source_name(s.source), s.controller.c_str(), s.speed, s.vibration ? "on" : "off", completed, runs.size(),
                 settled ? rmse / settled : std::nan(""), settled, est / n, danger, collisions, min_wall, wall / sim_s);
   return line;
 }
 
 // One run's rows of avoidance.csv and trajectories.csv.
-study::Record rows_of(const Setup& s, uint64_t run_seed, const avoidance::RunResult& r) {
+study::Record rows_of(const Setup& s, uint64_t run_seed, const loop::avoidance::RunResult& r) {
   std::ostringstream csv, traj;
-  const char* src = avoidance::source_name(s.source);
+  const char* src = loop::avoidance::source_name(s.source);
   csv << run_seed << ',' << s.speed << ',' << src << ',' << s.controller << ',' << r.heading_rmse_deg << ','
       << r.entered_danger << ',' << r.collided << ',' << (s.vibration ? "on" : "off") << ',' << r.completed << ',' << r.timed_out << ',' << r.settle_time_s
       << ',' << r.itse << ',' << r.activation_travel_m << ',' << r.min_wall_distance_m << ',' << r.estimate_rmse_deg
@@ -155,11 +155,11 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::from_str(log_level));
   const bool writer = session.rank() == 0;
 
-  avoidance::RunConfig base;
+  loop::avoidance::RunConfig base;
   std::vector<std::pair<std::string, flc::FlcSpec>> flcs;
   try {
-    base = avoidance::load_run_config(util::Config::load(config_file));
-    for (const auto& c : controllers) flcs.emplace_back(c, avoidance::controller_named(c));
+    base = loop::avoidance::load_avoidance_run(util::Config::load(config_file));
+    for (const auto& c : controllers) flcs.emplace_back(c, loop::avoidance::controller_named(c));
   } catch (const std::exception& e) {
     if (writer) std::fprintf(stderr, "aerie-bench-avoidance: %s\n", e.what());
     return 2;
@@ -170,14 +170,14 @@ int main(int argc, char** argv) {
   for (const auto& vib : vibrations)
     for (const auto& c : controllers)
       for (const auto& src : sources)
-        for (double v : speeds) setups.push_back({v, avoidance::source_from_name(src), c, vib == "on"});
+        for (double v : speeds) setups.push_back({v, loop::avoidance::source_from_name(src), c, vib == "on"});
   if (jobs > 1 || session.distributed()) cv::setNumThreads(1);  // one core per flight
   if (session.distributed() && jobs > 1 && writer)
     std::fprintf(stderr, "aerie-bench-avoidance: --jobs %d ignored under MPI (%d ranks, one flight each at a time)\n", jobs,
                  session.size());
-  std::vector<avoidance::RunConfig> configs;
+  std::vector<loop::avoidance::RunConfig> configs;
   for (const auto& s : setups) {
-    avoidance::RunConfig rc = base;
+    loop::avoidance::RunConfig rc = base;
     rc.source = s.source;
     rc.speed_m_s = s.speed;
     rc.sim.vibration.enabled = s.vibration;
@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
   std::ostringstream definition;
   definition << "runs=" << runs << " seed=" << seed << " config=" << config_file << " configurations:";
   for (const auto& s : setups)
-    definition << ' ' << avoidance::source_name(s.source) << '/' << s.controller << '/' << s.speed << "/vib"
+    definition << ' ' << loop::avoidance::source_name(s.source) << '/' << s.controller << '/' << s.speed << "/vib"
                << (s.vibration ? "on" : "off");
   std::vector<std::vector<Share>> shares(setups.size());
   std::vector<int> written(setups.size(), 0);
@@ -210,7 +210,9 @@ int main(int argc, char** argv) {
   st.definition = definition.str();
   st.run = [&](int index) {
     const auto k = static_cast<size_t>(index / runs);
-    const avoidance::RunResult r = avoidance::fly(configs[k], seed_of(index));
+    loop::avoidance::RunConfig rc = configs[k];
+    rc.seed = seed_of(index);
+    const loop::avoidance::RunResult r = loop::avoidance::fly(rc);
     if (r.sim_s <= 0) throw std::runtime_error("the flight simulated no time");
     return rows_of(setups[k], seed_of(index), r);
   };

@@ -21,12 +21,10 @@
 #include <sstream>
 #include <opencv2/core.hpp>
 
-#include "air/pilot/pilot_config.hpp"
 #include "air/track/factory.hpp"
 #include "common/logio/event_log.hpp"
-#include "common/sim/flight/flight_config.hpp"
 #include "bench/seeded_runs.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 #include "tools/study/study.hpp"
 
 using namespace aerie;
@@ -43,28 +41,22 @@ struct Files {
   std::string sim_dir, track, pilot, log_dir;
 };
 
-// The simulator's and the pilot's configuration of a setup, read once (plain data, shared by
-// the runs); each run sets its seed. The tracker's options hold YAML nodes, which are not
-// safe to share between threads: each run reads them itself.
-landing::RunConfig setup_config(const Setup& setup, const Files& files) {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(files.sim_dir + "/landing_" + setup.world + ".yaml"));
-  rc.sim.wind.mean_m_s = setup.wind;
-  rc.sim.vibration.enabled = setup.vibration;
-  rc.via = landing::via_from_string(setup.via);
-  YAML::Node pilot_yaml = YAML::LoadFile(files.pilot);
-  pilot_yaml["controller"] = setup.controller;
-  YAML::Emitter out;
-  out << pilot_yaml;
-  rc.pilot = pilot::load_pilot_config(util::Config::parse(out.c_str(), files.pilot));
-  return rc;
+// A setup's landing run (loop::landing::load_landing_run reads its files for each seed).
+loop::landing::LandingSpec setup_spec(const Setup& setup, const Files& files) {
+  loop::landing::LandingSpec spec;
+  spec.sim = files.sim_dir + "/landing_" + setup.world + ".yaml";
+  spec.track = files.track;
+  spec.pilot = files.pilot;
+  spec.tracker = setup.tracker;
+  spec.controller = setup.controller;
+  spec.wind_m_s = setup.wind;
+  spec.vibration = setup.vibration;
+  spec.via = loop::landing::via_from_string(setup.via);
+  return spec;
 }
 
-landing::RunResult fly(const Setup& setup, landing::RunConfig rc, uint64_t seed, const Files& files) {
-  rc.sim.seed = seed;
-  rc.track = track::node_options(util::Config::load(files.track));
-  rc.track.tracker = setup.tracker;
-  rc.track.seed = seed;
+loop::landing::RunResult fly(const Setup& setup, const loop::landing::LandingSpec& spec, uint64_t seed, const Files& files) {
+  loop::landing::RunConfig rc = loop::landing::load_landing_run(spec, seed);
   const std::string& log_dir = files.log_dir;
   std::unique_ptr<logio::Writer> log;
   if (!log_dir.empty()) {
@@ -79,7 +71,7 @@ landing::RunResult fly(const Setup& setup, landing::RunConfig rc, uint64_t seed,
       log->write(now_us, channel, data, size);
     };
   }
-  return landing::fly(rc);
+  return loop::landing::fly(rc);
 }
 
 double mean(const std::vector<double>& v) {
@@ -101,7 +93,7 @@ struct Tally {
   double n_desc = 0, n_fit = 0, wall = 0, sim_s = 0;
 };
 
-std::string note_of(const landing::RunResult& r) {
+std::string note_of(const loop::landing::RunResult& r) {
   double rm[4] = {0, 0, 0, 0}, fit[4] = {0, 0, 0, 0};
   size_t n_fit = 0;
   for (const auto& d : r.descent) {
@@ -165,7 +157,7 @@ std::string summary(const Setup& s, const Tally& t) {
 }
 
 // One run's rows of landings.csv and descent.csv.
-study::Record rows_of(const Setup& s, uint64_t run_seed, const landing::RunResult& r) {
+study::Record rows_of(const Setup& s, uint64_t run_seed, const loop::landing::RunResult& r) {
   std::ostringstream csv, desc;
   const char* vib = s.vibration ? "on" : "off";
   csv << run_seed << ',' << s.tracker << ',' << s.world << ',' << s.wind << ',' << vib << ',' << r.score.success << ','
@@ -257,10 +249,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "aerie-bench-landing: --jobs %d ignored under MPI (%d ranks, one landing each at a time)\n", jobs,
                  session.size());
   if (!files.log_dir.empty()) std::filesystem::create_directories(files.log_dir);
-  std::vector<landing::RunConfig> configs;
+  std::vector<loop::landing::LandingSpec> configs;
   for (const auto& s : setups) {
-    configs.push_back(setup_config(s, files));
+    configs.push_back(setup_spec(s, files));
     if (autopilot == "ardupilot") configs.back().autopilot = sim::autopilot::Personality::ArduCopter;
+  }
+  try {
+    for (const auto& spec : configs) loop::landing::load_landing_run(spec, seed);  // a bad file refused now, not per run
+  } catch (const std::exception& e) {
+    if (writer) std::fprintf(stderr, "aerie-bench-landing: %s\n", e.what());
+    return 2;
   }
 
   // One study over every configuration x seed (index = setup * runs + i), so that the ranks share
@@ -289,7 +287,7 @@ int main(int argc, char** argv) {
   st.definition = definition.str();
   st.run = [&](int index) {
     const auto k = static_cast<size_t>(index / runs);
-    const landing::RunResult r = fly(setups[k], configs[k], seed_of(index), files);
+    const loop::landing::RunResult r = fly(setups[k], configs[k], seed_of(index), files);
     if (r.sim_s <= 0) throw std::runtime_error("the flight simulated no time");
     return rows_of(setups[k], seed_of(index), r);
   };

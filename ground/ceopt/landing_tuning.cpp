@@ -12,14 +12,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "air/pilot/pilot_config.hpp"
-#include "air/track/node/track_node.hpp"
 #include "common/sim/vehicle/scenario_config.hpp"
 #include "common/util/time.hpp"
 #include "ground/ceopt/pipeline.hpp"
 #include "ground/ceopt/report.hpp"
 #include "ground/ceopt/thread_pool.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 
 namespace aerie::ceopt {
 namespace {
@@ -174,7 +172,10 @@ std::string pilot_yaml_with(const std::string& base_yaml, const std::vector<std:
   what << "the pilot configuration with";
   for (size_t i = 0; i < names.size(); ++i) what << " " << names[i] << "=" << four_digits(values[i]);
   try {
-    pilot::load_pilot_config(util::Config::parse(out.c_str(), what.str()));
+    loop::landing::LandingSpec check;
+    check.pilot = what.str();
+    check.pilot_yaml = out.c_str();
+    loop::landing::load_landing_pilot(check);
   } catch (const std::exception& e) {
     throw std::runtime_error(what.str() + " is invalid: " + e.what());
   }
@@ -194,10 +195,13 @@ double mean_cost(const std::vector<LandingRun>& runs, const LandingTuningConfig&
 
 LandingTuning::LandingTuning(LandingTuningConfig cfg) : cfg_(std::move(cfg)) {
   base_pilot_yaml_ = read_text(cfg_.pilot_config, "pilot configuration");
-  sim_ = sim::load_flight_config(util::Config::load(cfg_.sim_config));
-  sim_.wind.mean_m_s = cfg_.wind_m_s;
-  sim_.vibration.enabled = cfg_.vibration;
-  track::node_options(util::Config::load(cfg_.track_config));  // refuses a bad file now, not in a worker
+  spec_.sim = cfg_.sim_config;
+  spec_.track = cfg_.track_config;
+  spec_.pilot = cfg_.pilot_config;
+  spec_.tracker = cfg_.tracker;
+  spec_.wind_m_s = cfg_.wind_m_s;
+  spec_.vibration = cfg_.vibration;
+  loop::landing::load_landing_run(spec_, cfg_.training.first);  // refuses a bad file now, not in a worker
   // Every parameter's bounds must give a valid pilot (unknown names are refused here too).
   std::vector<double> lo, hi;
   for (const auto& p : cfg_.parameters) {
@@ -215,17 +219,12 @@ std::vector<std::string> LandingTuning::names() const {
 }
 
 std::vector<LandingRun> LandingTuning::fly(const std::vector<double>& x, const SeedRange& seeds) const {
-  landing::RunConfig rc;
-  rc.sim = sim_;
-  rc.pilot = pilot::load_pilot_config(util::Config::parse(pilot_yaml_with(base_pilot_yaml_, names(), x), cfg_.pilot_config));
+  loop::landing::LandingSpec spec = spec_;
+  spec.pilot_yaml = pilot_yaml_with(base_pilot_yaml_, names(), x);
   std::vector<LandingRun> runs;
   for (int i = 0; i < seeds.count; ++i) {
     const uint64_t seed = seeds.first + static_cast<uint64_t>(i);
-    rc.sim.seed = seed;
-    rc.track = track::node_options(util::Config::load(cfg_.track_config));  // YAML nodes: one copy per run
-    rc.track.tracker = cfg_.tracker;
-    rc.track.seed = seed;
-    const landing::RunResult r = landing::fly(rc);
+    const loop::landing::RunResult r = loop::landing::fly(loop::landing::load_landing_run(spec, seed));
     LandingRun l;
     l.seed = seed;
     l.success = r.score.success;

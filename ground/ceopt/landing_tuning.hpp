@@ -3,7 +3,7 @@
 // of thesis 5.1.4, Algorithm 3, applied to aerie-pilot's controller): a candidate is a set of
 // gains of config/pilot.yaml (`<axis>.<gain>`, e.g. horizontal.kp for forward and left
 // alike); its cost is the mean over the training seeds of one lock-step landing each
-// (tools/landing: the real flight simulator, tracking and pilot nodes):
+// (loop/landing.hpp: the real flight simulator, tracking and pilot nodes in loop::Harness):
 //   cost(run) = touchdown error (m) if the landing succeeded, else failure_cost_m,
 //               + time_weight_per_s * time to land (s, landed runs)
 // Every candidate flies the same seeds (common random numbers), so two candidates differ by
@@ -14,10 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "air/pilot/pilot.hpp"
-#include "common/sim/flight/flight_config.hpp"
 #include "common/util/config.hpp"
 #include "ground/ceopt/cross_entropy.hpp"
+#include "loop/landing.hpp"
 
 namespace aerie::ceopt {
 
@@ -79,7 +78,7 @@ class LandingTuning {
  private:
   LandingTuningConfig cfg_;
   std::string base_pilot_yaml_;
-  sim::FlightSimConfig sim_;
+  loop::landing::LandingSpec spec_;  // the files and what is set over them; the pilot's text per candidate
 };
 
 struct LandingTuningResult {

@@ -9,11 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "air/pilot/pilot_config.hpp"
 #include "air/track/factory.hpp"
 #include "common/bus/bus.hpp"
 #include "common/logio/event_log.hpp"
-#include "common/sim/flight/flight_config.hpp"
 #include "tools/latency/stats.hpp"
 
 namespace aerie::linkstudy {
@@ -63,12 +61,12 @@ std::vector<NodeIo> node_io(const StudyConfig& s, Workload w) {
     return {{"sim", {"CTRL_CMD"}, {"IMU", "CAM_DOWN", "GT_TRACK"}},
             {"track", {"CAM_DOWN", "GT_TRACK"}, {"TRACK", "TARGET_POSE"}},
             {"pilot", {"TARGET_POSE", "TRACK", "IMU"}, {"CTRL_CMD", "PILOT_STATE"}}};
-  const std::string pose = s.avoidance.source == avoidance::Source::kGt   ? "GT_POSE"
-                           : s.avoidance.source == avoidance::Source::kVo ? "VO_POSE"
+  const std::string pose = s.avoidance.source == loop::avoidance::Source::kGt   ? "GT_POSE"
+                           : s.avoidance.source == loop::avoidance::Source::kVo ? "VO_POSE"
                                                                           : "NAV_STATE";
   std::vector<NodeIo> io{{"sim", {"CTRL_CMD"}, {"IMU", "CAM_STEREO", "GT_POSE"}}, {"control", {pose}, {"CTRL_CMD"}}};
-  if (s.avoidance.source != avoidance::Source::kGt) io.push_back({"vo", {"CAM_STEREO"}, {"VO_POSE"}});
-  if (s.avoidance.source == avoidance::Source::kVio) io.push_back({"nav", {"IMU", "VO_POSE"}, {"NAV_STATE"}});
+  if (s.avoidance.source != loop::avoidance::Source::kGt) io.push_back({"vo", {"CAM_STEREO"}, {"VO_POSE"}});
+  if (s.avoidance.source == loop::avoidance::Source::kVio) io.push_back({"nav", {"IMU", "VO_POSE"}, {"NAV_STATE"}});
   return io;
 }
 
@@ -77,8 +75,8 @@ std::vector<NodeIo> node_io(const StudyConfig& s, Workload w) {
 std::vector<std::string> operator_channels(const StudyConfig& s, Workload w) {
   if (w == Workload::kReplay) return {"TRACK", "CAM_DOWN"};
   if (w == Workload::kLanding) return {"CAM_DOWN", "TRACK", "PILOT_STATE"};
-  return {s.avoidance.source == avoidance::Source::kGt ? "GT_POSE"
-          : s.avoidance.source == avoidance::Source::kVo ? "VO_POSE"
+  return {s.avoidance.source == loop::avoidance::Source::kGt ? "GT_POSE"
+          : s.avoidance.source == loop::avoidance::Source::kVo ? "VO_POSE"
                                                         : "NAV_STATE",
           "CTRL_CMD"};
 }
@@ -257,8 +255,8 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
   if (s.faults.empty()) fail("faults", "none given (leave the key out, or list \"none\" and the scenarios)");
   for (const auto& f : s.faults) {
     try {
-      const auto parsed = faults::parse_list(f);
-      faults::Injector check(parsed, 1);
+      const auto parsed = loop::faults::parse_list(f);
+      loop::faults::Injector check(parsed, 1);
       if (!parsed.empty() && has(Workload::kReplay))
         fail("faults", "faults are injected into closed-loop flights (landing, avoidance), not the replay; '" + f + "'");
     } catch (const std::invalid_argument& e) {
@@ -266,28 +264,22 @@ StudyConfig load_study(const util::Config& cfg, const std::string& base_dir) {
     }
   }
   if (has(Workload::kLanding) || has(Workload::kReplay)) {
-    s.track_file = path(cfg.get<std::string>("landing.track", "config/track_landing.yaml"));
-    const track::NodeOptions to = track::node_options(util::Config::load(s.track_file));  // refused now, not per run
+    s.landing = loop::landing::load_landing_spec(cfg.section("landing"), base_dir);
+    // Every file read now, so that a bad one is refused before the first run.
+    const track::NodeOptions to = loop::landing::load_landing_run(s.landing, s.first_seed).track;
     if (has(Workload::kReplay)) {
       if (!cfg.has("replay.log")) fail("replay.log", "the replay workload needs a recorded log (e.g. aerie-bench-landing --log-dir)");
       const std::string log = path(cfg.get<std::string>("replay.log", ""));
       if (!std::filesystem::is_regular_file(log)) fail("replay.log", "'" + log + "' is not a file");
-      s.replay = load_recording(log, to.camera_channel, to.gt_channel);  // once: every replay run shares it
+      s.replay = loop::replay::load_recording(log, to.camera_channel, to.gt_channel);  // once: every replay run shares it
     }
   }
-  if (has(Workload::kLanding)) {
-    s.landing.sim = sim::load_flight_config(util::Config::load(path(cfg.get<std::string>("landing.sim", "config/sim/landing_room.yaml"))));
-    s.landing.sim.wind.mean_m_s = cfg.get_in("landing.wind_m_s", s.landing.sim.wind.mean_m_s, 0.0, 20.0);
-    s.landing.sim.vibration.enabled = cfg.get("landing.vibration", s.landing.sim.vibration.enabled);
-    s.landing.sim.max_time_s = cfg.get_in("landing.max_time_s", s.landing.sim.max_time_s, 1.0, 3600.0);
-    s.landing.pilot = pilot::load_pilot_config(util::Config::load(path(cfg.get<std::string>("landing.pilot", "config/pilot.yaml"))));
-  }
   if (has(Workload::kAvoidance)) {
-    s.avoidance = avoidance::load_run_config(
+    s.avoidance = loop::avoidance::load_avoidance_run(
         util::Config::load(path(cfg.get<std::string>("avoidance.config", "config/avoidance.yaml"))), base_dir);
-    s.avoidance.controller = avoidance::controller_named(cfg.get<std::string>("avoidance.controller", "sfmf"), base_dir);
+    s.avoidance.controller = loop::avoidance::controller_named(cfg.get<std::string>("avoidance.controller", "sfmf"), base_dir);
     try {
-      s.avoidance.source = avoidance::source_from_name(cfg.get<std::string>("avoidance.source", "vio"));
+      s.avoidance.source = loop::avoidance::source_from_name(cfg.get<std::string>("avoidance.source", "vio"));
     } catch (const std::exception& e) {
       fail("avoidance.source", e.what());
     }
@@ -344,15 +336,13 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
 
   RunRow row;
   if (spec.workload == Workload::kLanding) {
-    landing::RunConfig rc = study.landing;
-    rc.sim.seed = spec.seed;
-    rc.track = track::node_options(util::Config::load(study.track_file));
-    rc.track.tracker = spec.tracker;
-    rc.track.seed = spec.seed;
+    loop::landing::LandingSpec ls = study.landing;
+    ls.tracker = spec.tracker;
+    loop::landing::RunConfig rc = loop::landing::load_landing_run(ls, spec.seed);
     rc.split = split;
     rc.on_message = tap;
-    rc.faults = faults::parse_list(spec.faults);
-    const landing::RunResult r = landing::fly(rc);
+    rc.faults = loop::faults::parse_list(spec.faults);
+    const loop::landing::RunResult r = loop::landing::fly(rc);
     row.success = r.score.success;
     row.collision = r.outcome.collided;
     row.metric = "touchdown_error_m";
@@ -371,14 +361,10 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     row.sim_s = r.sim_s;
     row.wall_s = r.wall_s;
   } else if (spec.workload == Workload::kReplay) {
-    ReplayConfig rc;
-    rc.recording = study.replay;
-    rc.track = track::node_options(util::Config::load(study.track_file));
-    rc.track.tracker = spec.tracker;
-    rc.track.seed = spec.seed;
+    loop::replay::RunConfig rc = loop::replay::load_replay_run(study.replay, study.landing.track, spec.tracker, spec.seed);
     rc.split = split;
     rc.on_message = tap;
-    const ReplayResult r = replay(rc);
+    const loop::replay::RunResult r = loop::replay::fly(rc);
     row.metric = "auc";
     row.auc = row.value = r.auc;
     row.mean_iou = r.mean_iou;
@@ -389,16 +375,17 @@ RunRow run(const StudyConfig& study, const RunSpec& spec, const std::string& log
     row.success = r.frames_visible > 0 && r.auc > 0 &&
                   static_cast<double>(r.frames_visible - r.frames_lost) >= 0.9 * static_cast<double>(r.frames_visible) &&
                   r.mean_iou >= 0.5;
-    row.down = r.down;
-    row.up = r.up;
+    row.down = r.link_down;
+    row.up = r.link_up;
     row.final_state = "replayed";
     row.sim_s = r.sim_s;
   } else {
-    avoidance::RunConfig rc = study.avoidance;
+    loop::avoidance::RunConfig rc = study.avoidance;
+    rc.seed = spec.seed;
     rc.split = split;
     rc.on_message = tap;
-    rc.faults = faults::parse_list(spec.faults);
-    const avoidance::RunResult r = avoidance::fly(rc, spec.seed);
+    rc.faults = loop::faults::parse_list(spec.faults);
+    const loop::avoidance::RunResult r = loop::avoidance::fly(rc);
     row.collision = r.collided;
     row.entered_danger = r.entered_danger;
     row.success = r.completed && !r.collided && !r.entered_danger;

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "common/util/config.hpp"
-#include "tools/avoidance/avoidance_run.hpp"
+#include "loop/avoidance.hpp"
+#include "loop/landing.hpp"
+#include "loop/replay.hpp"
 #include "tools/latency/link_hops.hpp"
-#include "tools/linkstudy/replay_run.hpp"
-#include "tools/landing/landing_run.hpp"
 #include "tools/link/sim_link.hpp"
 
 namespace aerie::linkstudy {
@@ -52,19 +52,18 @@ struct StudyConfig {
   std::vector<Placement> placements;
   std::vector<Workload> workloads;
   std::vector<std::string> trackers{"amcmr-ct"};  // landing and replay workloads
-  // Fault scenarios (tools/faults, docs/faults.md), each one or more specs separated by
+  // Fault scenarios (loop/faults.hpp, docs/faults.md), each one or more specs separated by
   // spaces; "none" flies without a fault. Closed-loop workloads (landing, avoidance) only.
   std::vector<std::string> faults{"none"};
   uint64_t first_seed = 1;
   int seeds = 3;
   int64_t queue_bytes = 262144;    // the radio's buffer per direction
-  // landing workload
-  landing::RunConfig landing;      // sim, pilot, track (tracker and seed set per run)
-  std::string track_file;          // the tracker's options are read per run (not thread-safe to share)
-  // avoidance workload
-  avoidance::RunConfig avoidance;
+  // landing workload: its `landing:` section (loop::landing::load_landing_spec; tracker and seed set per run)
+  loop::landing::LandingSpec landing;
+  // avoidance workload (seed set per run)
+  loop::avoidance::RunConfig avoidance;
   // replay workload (open loop): a recorded log through the link; the tracker as landing.track says
-  std::shared_ptr<const Recording> replay;
+  std::shared_ptr<const loop::replay::Recording> replay;
 };
 
 // The built-in placements (docs/linkstudy.md):
@@ -115,7 +114,7 @@ struct RunRow {
   std::vector<latency::LinkHop> hops;  // the air and ground logs joined (aerie-latency AIR GROUND)
   double down_kbit_s = 0, up_kbit_s = 0;  // delivered wire bytes per simulated second
   std::string final_state;
-  faults::Report faults;           // landing, avoidance: what the flight saw of its faults
+  loop::faults::Report faults;     // landing, avoidance: what the flight saw of its faults
   double sim_s = 0, wall_s = 0;
 };
 

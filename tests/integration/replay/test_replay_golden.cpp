@@ -21,7 +21,7 @@
 #include "air/stereo/node/vo_node.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/sim/flight/flight_config.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 
 using namespace aerie;
 
@@ -35,20 +35,17 @@ struct Message {
 
 // 10 s of a seeded landing flight (take-off, the pad found) with the stereo pair: the sensor messages only.
 std::vector<Message> record_flight() {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = 3;
+  loop::landing::RunConfig rc =
+      loop::landing::load_landing_run(util::Config::parse("max_time_s: 10\n", "test_replay_golden"), 3, AERIE_SOURCE_DIR);
   rc.sim.stereo = true;
-  rc.sim.max_time_s = 10;
   rc.frames_after_end = 0;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
+  rc.track.seed = 1;  // the tracker's seed the stored digest's flight was flown with
   const std::set<std::string> sensors{"IMU", "GT_POSE", "GT_TRACK", "CAM_DOWN", "CAM_STEREO"};
   std::vector<Message> log;
   rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
     if (sensors.count(channel)) log.push_back({channel, {data, data + size}});
   };
-  landing::fly(rc);
+  loop::landing::fly(rc);
   return log;
 }
 

@@ -7,22 +7,15 @@
 #include <string>
 #include <vector>
 
-#include "air/pilot/pilot_config.hpp"
-#include "common/sim/flight/flight_config.hpp"
 #include "tests/support/lockstep_bytes.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 #include "tools/link/sim_link.hpp"
 
 namespace aerie::door_test {
 
-inline landing::RunConfig landing_split(uint64_t seed, const std::string& up_channels = "TRACK|TARGET_POSE") {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = seed;
-  rc.sim.max_time_s = 60;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.track.tracker = "amcmr-ct";
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
+inline loop::landing::RunConfig landing_split(uint64_t seed, const std::string& up_channels = "TRACK|TARGET_POSE") {
+  loop::landing::RunConfig rc = loop::landing::load_landing_run(
+      util::Config::parse("tracker: amcmr-ct\nmax_time_s: 60\n", "split_landing.hpp"), seed, AERIE_SOURCE_DIR);
   link::Split split;
   split.nodes = {{"track", link::Side::kGround}};  // images down, the tracker's results up
   split.down.channels = "CAM_DOWN|GT_TRACK";
@@ -45,12 +38,12 @@ struct Message {
 };
 
 // Every message on both buses; TRACK with its processing time (wall clock) zeroed.
-inline std::vector<Message> record(landing::RunConfig rc, landing::RunResult& result) {
+inline std::vector<Message> record(loop::landing::RunConfig rc, loop::landing::RunResult& result) {
   std::vector<Message> out;
   rc.on_message = [&](link::Side side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
     out.push_back(Message{side, channel, test::comparable_bytes(channel, data, size)});
   };
-  result = landing::fly(rc);
+  result = loop::landing::fly(rc);
   return out;
 }
 

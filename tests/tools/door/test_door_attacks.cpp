@@ -48,8 +48,8 @@ std::shared_ptr<const seal::OperatorKey> operator_key() {
 
 // As test_door_landing's split, with the operator's commands also allowed up (as the secure
 // config/link.yaml carries them): the policy would let them cross, the seal is what refuses.
-landing::RunConfig landing_split(std::shared_ptr<const seal::SecretKey> key) {
-  landing::RunConfig rc = door_test::landing_split(2, "TRACK|TARGET_POSE|PILOT_CMD|TRACK_CMD|FLC_PARAMS|MAP_CMD");
+loop::landing::RunConfig landing_split(std::shared_ptr<const seal::SecretKey> key) {
+  loop::landing::RunConfig rc = door_test::landing_split(2, "TRACK|TARGET_POSE|PILOT_CMD|TRACK_CMD|FLC_PARAMS|MAP_CMD");
   link::SimDoor door;
   door.key = std::move(key);  // default rekeying: one epoch for the flight, so each refusal's reason is exact
   door.operator_channels = link::kDefaultOperatorChannels;  // the operator signs, as aerie-link's halves
@@ -273,10 +273,10 @@ class Attacker {
 
 TEST(DoorAttacks, EveryAttackOfTheProbeIsRefusedAndCountedAndTheVehicleLandsAsWithout) {
   const auto key = std::make_shared<const seal::SecretKey>(seal::SecretKey::generate());
-  landing::RunResult plain, attacked;
+  loop::landing::RunResult plain, attacked;
   const auto a = record(landing_split(key), plain);
   Attacker attacker(key);
-  landing::RunConfig rc = landing_split(key);
+  loop::landing::RunConfig rc = landing_split(key);
   attacker.attach(*rc.split->door);
   const auto b = record(rc, attacked);
 

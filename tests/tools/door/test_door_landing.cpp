@@ -65,9 +65,9 @@ TEST(SimDoor, SealsAndOpensEveryMessageAndRekeysOnSimulationTime) {
 }
 
 TEST(SimDoor, ALockStepLandingWithTheDoorRekeyingEvery10sLandsExactlyAsWithout) {
-  landing::RunResult plain, sealed;
+  loop::landing::RunResult plain, sealed;
   const auto a = record(landing_split(2), plain);
-  landing::RunConfig rc = landing_split(2);
+  loop::landing::RunConfig rc = landing_split(2);
   rc.split->door = door_every_10s();
   const auto b = record(rc, sealed);
 

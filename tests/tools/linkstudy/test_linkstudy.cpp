@@ -126,11 +126,8 @@ TEST(LinkStudy, WhatCrossesFollowsThePlacement) {
 TEST(LinkStudy, AnOnboardPlacementOverAPerfectLinkFliesAsWithoutALink) {
   auto study = linkstudy::load_study(util::Config::parse(with("placements: [onboard]", "placements: [ground-tracking]"),
                                                          "study.yaml"), kSource);
-  landing::RunConfig rc = study.landing;
-  rc.sim.seed = 4;
-  rc.track = track::node_options(util::Config::load(study.track_file));
-  rc.track.seed = 4;
-  const landing::RunResult plain = landing::fly(rc);
+  const loop::landing::RunConfig rc = loop::landing::load_landing_run(study.landing, 4);
+  const loop::landing::RunResult plain = loop::landing::fly(rc);
   const linkstudy::RunRow row = linkstudy::run(study, {&study.sweeps[0].conditions[0], &study.placements[0],
                                                        linkstudy::Workload::kLanding, "amcmr-ct", 4});
   EXPECT_EQ(row.sim_s, plain.sim_s);
@@ -175,16 +172,14 @@ TEST(LinkStudy, ReplayScoresTheBoxesThatReachTheOperator) {
   const std::string log = (dir / "flight.lcm").string();
   {
     auto study = linkstudy::load_study(util::Config::parse(kStudy, "study.yaml"), kSource);
-    landing::RunConfig rc = study.landing;
-    rc.sim.seed = 4;
+    loop::landing::RunConfig rc = loop::landing::load_landing_run(study.landing, 4);
     rc.sim.max_time_s = 12;
     rc.frames_after_end = 0;
-    rc.track = track::node_options(util::Config::load(study.track_file));
     logio::Writer w(log);
     rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t now_us) {
       w.write(now_us, channel, data, size);
     };
-    landing::fly(rc);
+    loop::landing::fly(rc);
   }
   std::ofstream(dir / "replay.yaml") << "seeds: {first: 1, count: 1}\nsweeps: {loss: {values: [0, 0.3]}}\n"
                                         "placements: [onboard, ground-tracking]\nworkloads: [replay]\n"

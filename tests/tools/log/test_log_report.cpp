@@ -30,7 +30,7 @@
 #include "common/sim/flight/flight_config.hpp"
 #include "ground/map/octomap_message.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 #include "tools/log/log_report.hpp"
 
 namespace aerie::logtools {
@@ -411,13 +411,9 @@ TEST(LogReport, TheCommandRefusesAWrongOptionAndAMissingLog) {
 // The demo's loop (flight simulator, aerie-track and aerie-pilot in lock-step), 12 s of it
 // recorded as the demo's logger would, then reported.
 TEST(LogReport, AShortClosedLoopFlightGetsItsReport) {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = 3;
-  rc.sim.max_time_s = 12;
+  loop::landing::RunConfig rc =
+      loop::landing::load_landing_run(util::Config::parse("max_time_s: 12\n", "test_log_report"), 3, AERIE_SOURCE_DIR);
   rc.frames_after_end = 0;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
   const fs::path dir = test::scratch_dir("loop");
   const fs::path log = dir / "demo.lcm";
   std::map<std::string, int64_t> counts;
@@ -427,7 +423,7 @@ TEST(LogReport, AShortClosedLoopFlightGetsItsReport) {
       w.write(now_us, channel, data, size);
       ++counts[channel];
     };
-    landing::fly(rc);
+    loop::landing::fly(rc);
   }
   const auto count = [&](const char* ch) { return counts.count(ch) ? counts.at(ch) : int64_t{0}; };
   ASSERT_GT(count("SIM_STATE"), 0);

@@ -9,15 +9,15 @@
 #include <vector>
 
 #include "common/flc/flc_io.hpp"
-#include "tools/avoidance/avoidance_run.hpp"
+#include "loop/avoidance.hpp"
 
 using namespace aerie;
 
 namespace {
 
-avoidance::RunConfig config(avoidance::Source source, double speed) {
-  avoidance::RunConfig rc =
-      avoidance::load_run_config(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
+loop::avoidance::RunConfig config(loop::avoidance::Source source, double speed) {
+  loop::avoidance::RunConfig rc =
+      loop::avoidance::load_avoidance_run(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
   rc.source = source;
   rc.speed_m_s = speed;
   rc.controller = flc::load_controller(AERIE_SOURCE_DIR "/config/flc/sfmf.yaml");
@@ -27,16 +27,16 @@ avoidance::RunConfig config(avoidance::Source source, double speed) {
 }  // namespace
 
 TEST(AvoidanceLoop, VoPlusImuFliesPastTheWallParallelAndTheSameTwice) {
-  avoidance::RunConfig rc = config(avoidance::Source::kVio, 0.6);
+  loop::avoidance::RunConfig rc = config(loop::avoidance::Source::kVio, 0.6);
   std::vector<std::vector<uint8_t>> commands[2];
-  avoidance::RunResult r[2];
+  loop::avoidance::RunResult r[2];
   for (int i = 0; i < 2; ++i) {
     rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
       if (channel == "CTRL_CMD") commands[i].emplace_back(data, data + size);
     };
-    r[i] = avoidance::fly(rc, 1);
+    r[i] = loop::avoidance::fly(rc);
   }
-  const avoidance::RunResult& a = r[0];
+  const loop::avoidance::RunResult& a = r[0];
   EXPECT_TRUE(a.completed);
   EXPECT_FALSE(a.collided) << a.collision;
   EXPECT_FALSE(a.entered_danger);
@@ -62,17 +62,17 @@ TEST(AvoidanceLoop, VoPlusImuFliesPastTheWallParallelAndTheSameTwice) {
 }
 
 TEST(AvoidanceLoop, ABadScenarioIsRefusedNamingWhatIsWrong) {
-  avoidance::RunConfig rc = config(avoidance::Source::kGt, 0.6);
+  loop::avoidance::RunConfig rc = config(loop::avoidance::Source::kGt, 0.6);
   rc.scene.wall_y_m = 7;  // the room's wall is 5 m ahead of the start
   try {
-    avoidance::fly(rc, 1);
+    loop::avoidance::fly(rc);
     FAIL() << "flew a scenario whose wall is not where it says";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("scene.wall_m is 7"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(avoidance::source_from_name("imu"), std::invalid_argument);
+  EXPECT_THROW(loop::avoidance::source_from_name("imu"), std::invalid_argument);
   try {
-    avoidance::load_run_config(util::Config::parse("sim: {placement: {start_height_m: 1}}\n", "a.yaml"), AERIE_SOURCE_DIR);
+    loop::avoidance::load_avoidance_run(util::Config::parse("sim: {placement: {start_height_m: 1}}\n", "a.yaml"), AERIE_SOURCE_DIR);
     FAIL() << "accepted a scenario without a start";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("a.yaml: sim.placement needs start_x_m"), std::string::npos) << e.what();

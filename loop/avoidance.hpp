@@ -1,6 +1,6 @@
 #pragma once
-// One collision-avoidance flight of thesis 5.1.2 / Fig. 5.2 in the closed-loop simulator, in
-// lock-step: the flight simulator node renders the forward stereo pair and the IMU; the real
+// The avoidance scenario of the harness (loop/harness.hpp): one collision-avoidance flight of
+// thesis 5.1.2 / Fig. 5.2 in lock-step: the simulator renders the forward stereo pair and the IMU; the real
 // aerie-vo, aerie-nav and aerie-control classes run on one in-process LCM bus (memq://), and
 // aerie-control steers the vehicle on the heading source under test:
 //   gt  — GT_POSE (the simulator's truth);
@@ -12,7 +12,7 @@
 // scene.lateral_limit_m sideways, a collision, or the time limit. Every node handles its
 // messages on the calling thread, so a frame is answered when the bus is empty: a run is a
 // function of its configuration and seed. With a split, "vo", "nav" and "control" may run on
-// the ground side, behind the link in simulation time (tools/link/sim_link.hpp).
+// the ground side, behind the link in simulation time.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -26,16 +26,17 @@
 #include "common/sim/flight/flight_sim.hpp"
 #include "common/sim/vehicle/avoidance.hpp"
 #include "common/util/config.hpp"
-#include "tools/faults/faults.hpp"
-#include "tools/link/sim_link.hpp"
+#include "loop/harness.hpp"
 
-namespace aerie::avoidance {
+namespace aerie::loop::avoidance {
 
 enum class Source { kGt, kVo, kVio };
 Source source_from_name(const std::string& name);  // gt | vo | vio; throws std::invalid_argument
 const char* source_name(Source source);
 
-struct RunConfig {
+// Wiring: the seed, the split ("vo", "nav", "control" on the ground side), the tap and the
+// faults (the nodes that run — "vo", "nav", "control" — can be killed).
+struct RunConfig : Wiring {
   sim::FlightSimConfig sim;     // stereo on; a given start, hovering, facing the wall
   sim::Scene scene;             // zones along the start heading (thesis Fig. 5.2)
   double settle_band_deg = 4.5; // steady state: after the last time |error| > this
@@ -45,19 +46,13 @@ struct RunConfig {
   control::NodeOptions control; // input, channel, rate (one command per input) and heading frame are set per source
   stereo::VoNodeConfig vo;      // its bundle adjustment runs synchronously here (reproducible)
   nav::NavConfig nav;
-  // Nodes "vo", "nav" and "control" on the ground side, and the link; none: one bus.
-  std::optional<link::Split> split;
-  // Sees every message on each side's bus in bus order, with the simulation time it is
-  // handled at, e.g. to record it (the air side only without a split).
-  link::SplitBus::Tap on_message;
-  // Injected during the flight (tools/faults): the nodes that run ("vo", "nav", "control") can be killed.
-  std::vector<faults::Fault> faults;
 };
 
 // config/avoidance.yaml: `sim:` (config/sim/landing_room.yaml's keys), `scene:`,
 // `settle_band_deg`, `control:` (stale_timeout_s, limits) and the files of `vo:` and `nav:`
 // (relative paths from base_dir, the repository root). Throws naming the file and key.
-RunConfig load_run_config(const util::Config& cfg, const std::string& base_dir = ".");
+// The controller is the thesis' initial one; the seed 1.
+RunConfig load_avoidance_run(const util::Config& cfg, const std::string& base_dir = ".");
 
 // "initial": the thesis' initial FLC; a bare name: config/flc/NAME.yaml under base_dir (sf,
 // sfmf: aerie-ceopt's); else a file. Throws naming the file.
@@ -72,20 +67,17 @@ struct Sample {
   bool turning = false;
 };
 
-struct RunResult {
+struct RunResult : RunStats {
   bool activated = false, completed = false, collided = false, entered_danger = false, timed_out = false;
   std::string collision;
   double activation_travel_m = 0;   // true travel when aerie-control started the turn (its estimate said 1 m)
   double settle_time_s = -1, heading_rmse_deg = -1, itse = 0;  // sim::SettlingStats of the true heading
   double min_wall_distance_m = 0;
   double estimate_rmse_deg = std::nan("");  // heading estimate vs truth over the flight
-  int64_t vo_poses = 0, vo_not_ok = 0, nav_gated = 0, commands_fallback = 0, lockstep_timeouts = 0, commands_refused = 0;
-  link::DirectionCounters link_down, link_up;  // with a split
-  faults::Report faults;
-  double sim_s = 0, wall_s = 0;
+  int64_t vo_poses = 0, vo_not_ok = 0, nav_gated = 0, commands_fallback = 0;
   std::vector<Sample> trajectory;
 };
 
-RunResult fly(const RunConfig& config, uint64_t seed);
+RunResult fly(const RunConfig& config);
 
-}  // namespace aerie::avoidance
+}  // namespace aerie::loop::avoidance

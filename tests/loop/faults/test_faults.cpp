@@ -1,4 +1,4 @@
-// Faults in flight (tools/faults, docs/faults.md): the spec language, the injector's draws, a
+// Faults in flight (loop/faults.hpp, docs/faults.md): the spec language, the injector's draws, a
 // node killed and respawned on the bus, and one short lock-step landing per fault category —
 // the vehicle stays safe, reacts as it must, and the fault did what it says — plus a wrong
 // calibration refused at start-up.
@@ -16,9 +16,9 @@
 #include "common/flc/flc_io.hpp"
 #include "common/sim/flight/flight_config.hpp"
 #include "tests/support/test_support.hpp"
-#include "tools/avoidance/avoidance_run.hpp"
-#include "tools/faults/faults.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/avoidance.hpp"
+#include "loop/faults.hpp"
+#include "loop/landing.hpp"
 
 using namespace aerie;
 
@@ -26,7 +26,7 @@ namespace {
 
 std::string refusal(const std::string& spec) {
   try {
-    faults::parse(spec);
+    loop::faults::parse(spec);
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
@@ -34,19 +34,14 @@ std::string refusal(const std::string& spec) {
 }
 
 // Seed 1 of the room: take-off done at about 5 s, landed at about 21 s without a fault.
-landing::RunConfig landing_with(const std::string& faults) {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = 1;
-  rc.sim.max_time_s = 60;
-  rc.sim.wind.mean_m_s = 1.0;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
-  rc.faults = faults::parse_list(faults);
+loop::landing::RunConfig landing_with(const std::string& faults) {
+  loop::landing::RunConfig rc = loop::landing::load_landing_run(
+      util::Config::parse("max_time_s: 60\nwind_m_s: 1\n", "test_faults"), 1, AERIE_SOURCE_DIR);
+  rc.faults = loop::faults::parse_list(faults);
   return rc;
 }
 
-void expect_safe(const landing::RunResult& r) {
+void expect_safe(const loop::landing::RunResult& r) {
   EXPECT_FALSE(r.outcome.collided) << r.outcome.collision;
   EXPECT_TRUE(r.final_state == "LANDED" || r.final_state == "HOLD" || r.final_state == "ABORTED") << r.final_state;
 }
@@ -56,16 +51,16 @@ void expect_safe(const landing::RunResult& r) {
 TEST(FaultSpec, EveryKindParsesAndReadsBack) {
   for (const std::string s : {"kill:track@8+1", "kill:pilot@4~16+1", "camera_stall@6+3", "link_drop@6.5+10",
                               "link_degrade@13+300:500:0.3", "burst@8:10000", "nan_pose:TARGET_POSE@9"})
-    EXPECT_EQ(faults::to_string(faults::parse(s)), s);
-  const faults::Fault f = faults::parse("link_degrade@4~16+300:500:0.3");
-  EXPECT_EQ(f.kind, faults::Kind::LinkDegrade);
+    EXPECT_EQ(loop::faults::to_string(loop::faults::parse(s)), s);
+  const loop::faults::Fault f = loop::faults::parse("link_degrade@4~16+300:500:0.3");
+  EXPECT_EQ(f.kind, loop::faults::Kind::LinkDegrade);
   EXPECT_DOUBLE_EQ(f.at_s, 4);
   EXPECT_DOUBLE_EQ(f.at_max_s, 16);
   EXPECT_DOUBLE_EQ(f.duration_s, 300);
   EXPECT_DOUBLE_EQ(f.delay_ms, 500);
   EXPECT_DOUBLE_EQ(f.loss, 0.3);
-  EXPECT_EQ(faults::parse_list("none").size(), 0u);
-  EXPECT_EQ(faults::parse_list("link_drop@8+5 link_degrade@13+300:500:0.3").size(), 2u);
+  EXPECT_EQ(loop::faults::parse_list("none").size(), 0u);
+  EXPECT_EQ(loop::faults::parse_list("link_drop@8+5 link_degrade@13+300:500:0.3").size(), 2u);
 }
 
 TEST(FaultSpec, BadSpecsAreRefusedNamingWhatIsWrong) {
@@ -79,11 +74,11 @@ TEST(FaultSpec, BadSpecsAreRefusedNamingWhatIsWrong) {
   EXPECT_NE(refusal("camera_stall@9~3+1").find("ends before it starts"), std::string::npos);
   EXPECT_NE(refusal("camera_stall:CAM@3+1").find("takes no target"), std::string::npos);
   EXPECT_NE(refusal("kill:track").find("expected KIND[:TARGET]@TIME"), std::string::npos);
-  EXPECT_THROW(faults::Injector(faults::parse_list("kill:track@8+2 kill:track@9+1"), 1), std::invalid_argument);
+  EXPECT_THROW(loop::faults::Injector(loop::faults::parse_list("kill:track@8+2 kill:track@9+1"), 1), std::invalid_argument);
 }
 
 TEST(FaultSpec, TimesGivenAsRangesAreDrawnFromTheSeed) {
-  auto drawn = [](uint64_t seed) { return faults::Injector(faults::parse_list("kill:track@4~16+1"), seed).faults()[0].at_s; };
+  auto drawn = [](uint64_t seed) { return loop::faults::Injector(loop::faults::parse_list("kill:track@4~16+1"), seed).faults()[0].at_s; };
   EXPECT_EQ(drawn(3), drawn(3));
   EXPECT_NE(drawn(3), drawn(4));
   for (uint64_t seed = 1; seed <= 50; ++seed) {
@@ -102,7 +97,7 @@ TEST(Respawnable, AKilledNodeLeavesTheBusAndComesBackFresh) {
   bus::Bus bus("memq://");
   int others = 0;
   bus.subscribe<aerie::pose_t>("VO_POSE", [&](const aerie::pose_t&, const bus::ReceiveInfo&) { ++others; });
-  faults::Respawnable<Counter> node(bus, [&] { return std::make_unique<Counter>(bus); });
+  loop::faults::Respawnable<Counter> node(bus, [&] { return std::make_unique<Counter>(bus); });
   auto deliver = [&](int n) {
     for (int i = 0; i < n; ++i) bus.publish("VO_POSE", aerie::pose_t{});
     while (bus.handle(0) > 0) {
@@ -121,7 +116,7 @@ TEST(Respawnable, AKilledNodeLeavesTheBusAndComesBackFresh) {
 }
 
 TEST(FaultsInFlight, AKilledTrackerIsRespawnedThePilotHoldsAndTheLandingCompletes) {
-  const landing::RunResult r = landing::fly(landing_with("kill:track@8+1"));
+  const loop::landing::RunResult r = loop::landing::fly(landing_with("kill:track@8+1"));
   expect_safe(r);
   EXPECT_EQ(r.faults.counters.kills, 1);
   EXPECT_EQ(r.faults.counters.respawns, 1);
@@ -131,14 +126,14 @@ TEST(FaultsInFlight, AKilledTrackerIsRespawnedThePilotHoldsAndTheLandingComplete
 }
 
 TEST(FaultsInFlight, ADeadPilotLeavesTheAutopilotHoldingAndItsRespawnLands) {
-  const landing::RunResult r = landing::fly(landing_with("kill:pilot@8+3"));
+  const loop::landing::RunResult r = loop::landing::fly(landing_with("kill:pilot@8+3"));
   expect_safe(r);
   EXPECT_EQ(r.faults.command_timeouts, 1);  // no command for 1 s: the autopilot hovers (offboard loss)
   EXPECT_TRUE(r.score.success) << r.final_state;
 }
 
 TEST(FaultsInFlight, AStalledCameraHoldsThePilotUntilFramesReturn) {
-  const landing::RunResult r = landing::fly(landing_with("camera_stall@8+3"));
+  const loop::landing::RunResult r = loop::landing::fly(landing_with("camera_stall@8+3"));
   expect_safe(r);
   EXPECT_EQ(r.faults.stalled_frames, 60);  // 3 s at 20 Hz
   EXPECT_GE(r.pilot_stale_holds, 1);
@@ -146,14 +141,14 @@ TEST(FaultsInFlight, AStalledCameraHoldsThePilotUntilFramesReturn) {
 }
 
 TEST(FaultsInFlight, ALinkDropWithTrackingOnTheGroundHoldsTheVehicle) {
-  landing::RunConfig rc = landing_with("link_drop@8+5");
+  loop::landing::RunConfig rc = landing_with("link_drop@8+5");
   link::Split split;
   split.nodes = {{"track", link::Side::kGround}};  // images down, the tracker's results up
   split.down.channels = "CAM_DOWN|GT_TRACK";
   split.up.channels = "TRACK|TARGET_POSE";
   split.up.name = "ground->air";
   rc.split = split;
-  const landing::RunResult r = landing::fly(rc);
+  const loop::landing::RunResult r = loop::landing::fly(rc);
   expect_safe(r);
   EXPECT_GT(r.link_down.dropped_outage, 90);  // 5 s of CAM_DOWN and GT_TRACK at 20 Hz, and what was in flight
   EXPECT_GE(r.pilot_stale_holds, 1);
@@ -161,7 +156,7 @@ TEST(FaultsInFlight, ALinkDropWithTrackingOnTheGroundHoldsTheVehicle) {
 }
 
 TEST(FaultsInFlight, AMalformedBurstIsCountedAndTheLandingGoesOn) {
-  const landing::RunResult r = landing::fly(landing_with("burst@8:10000"));
+  const loop::landing::RunResult r = loop::landing::fly(landing_with("burst@8:10000"));
   expect_safe(r);
   EXPECT_EQ(r.faults.counters.burst_messages, 10000);
   EXPECT_GT(r.faults.malformed, 1000);  // random, truncated and hostile-length messages refused by the decoders
@@ -169,7 +164,7 @@ TEST(FaultsInFlight, AMalformedBurstIsCountedAndTheLandingGoesOn) {
 }
 
 TEST(FaultsInFlight, ANanTargetPoseIsRefusedByThePilot) {
-  const landing::RunResult r = landing::fly(landing_with("nan_pose:TARGET_POSE@10"));
+  const loop::landing::RunResult r = loop::landing::fly(landing_with("nan_pose:TARGET_POSE@10"));
   expect_safe(r);
   EXPECT_EQ(r.faults.counters.nan_messages, 1);
   EXPECT_EQ(r.pilot_refused, 1);
@@ -177,8 +172,8 @@ TEST(FaultsInFlight, ANanTargetPoseIsRefusedByThePilot) {
 }
 
 TEST(FaultsInFlight, AFaultedFlightIsAsReproducibleAsACleanOne) {
-  const landing::RunResult a = landing::fly(landing_with("kill:track@7~9+1 burst@12:2000"));
-  const landing::RunResult b = landing::fly(landing_with("kill:track@7~9+1 burst@12:2000"));
+  const loop::landing::RunResult a = loop::landing::fly(landing_with("kill:track@7~9+1 burst@12:2000"));
+  const loop::landing::RunResult b = loop::landing::fly(landing_with("kill:track@7~9+1 burst@12:2000"));
   EXPECT_EQ(a.faults.applied, b.faults.applied);
   EXPECT_EQ(a.outcome.touchdown_position, b.outcome.touchdown_position);
   EXPECT_EQ(a.faults.malformed, b.faults.malformed);
@@ -186,11 +181,11 @@ TEST(FaultsInFlight, AFaultedFlightIsAsReproducibleAsACleanOne) {
 }
 
 TEST(FaultsInFlight, TheAvoidanceFlightCompletesThroughAVoRestartAndABurst) {
-  avoidance::RunConfig rc =
-      avoidance::load_run_config(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
+  loop::avoidance::RunConfig rc =
+      loop::avoidance::load_avoidance_run(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
   rc.controller = flc::load_controller(AERIE_SOURCE_DIR "/config/flc/sfmf.yaml");
-  rc.faults = faults::parse_list("kill:vo@3+1 burst@7:5000");
-  const avoidance::RunResult r = avoidance::fly(rc, 1);
+  rc.faults = loop::faults::parse_list("kill:vo@3+1 burst@7:5000");
+  const loop::avoidance::RunResult r = loop::avoidance::fly(rc);
   EXPECT_FALSE(r.collided) << r.collision;
   EXPECT_FALSE(r.entered_danger);
   EXPECT_TRUE(r.completed);  // aerie-nav bridges the VO's restart (a new VO frame is a new anchor)
@@ -200,8 +195,8 @@ TEST(FaultsInFlight, TheAvoidanceFlightCompletesThroughAVoRestartAndABurst) {
   EXPECT_GT(r.faults.malformed, 500);
   EXPECT_THROW(
       [&] {
-        rc.faults = faults::parse_list("kill:track@3+1");  // no tracker in this flight
-        avoidance::fly(rc, 1);
+        rc.faults = loop::faults::parse_list("kill:track@3+1");  // no tracker in this flight
+        loop::avoidance::fly(rc);
       }(),
       std::invalid_argument);
 }
@@ -211,13 +206,13 @@ TEST(FaultsInFlight, AvoidanceCompletesThroughAControlOrANavRestart) {
   // started a new frame: both flew into the wall, then hovered once aerie-control refused them.
   // Now the respawned aerie-control takes the anchor up from its file and the respawned
   // aerie-nav resumes in its frame from its state file: the turn is completed through either.
-  avoidance::RunConfig rc =
-      avoidance::load_run_config(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
+  loop::avoidance::RunConfig rc =
+      loop::avoidance::load_avoidance_run(util::Config::load(AERIE_SOURCE_DIR "/config/avoidance.yaml"), AERIE_SOURCE_DIR);
   rc.controller = flc::load_controller(AERIE_SOURCE_DIR "/config/flc/sfmf.yaml");
   rc.sim.max_time_s = 20;
   for (const char* fault : {"kill:control@5+1", "kill:nav@6+1"}) {
-    rc.faults = faults::parse_list(fault);
-    const avoidance::RunResult r = avoidance::fly(rc, 1);
+    rc.faults = loop::faults::parse_list(fault);
+    const loop::avoidance::RunResult r = loop::avoidance::fly(rc);
     EXPECT_FALSE(r.collided) << fault << ": " << r.collision;
     EXPECT_FALSE(r.entered_danger) << fault;
     EXPECT_TRUE(r.completed) << fault;

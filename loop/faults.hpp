@@ -4,7 +4,7 @@
 // degrading, a burst of malformed messages on every channel, a NaN pose. A fault starts at
 // a simulation time, so a faulted flight is as reproducible as a clean one.
 //
-// A run (tools/landing, tools/avoidance) describes its Flight and calls Injector::step once
+// A run (loop::Harness, which owns the injector) describes its Flight and calls Injector::step once
 // per frame before its buses settle; the injector sees every message through the buses' tap.
 #include <cstdint>
 #include <functional>
@@ -18,7 +18,7 @@
 #include "common/bus/bus.hpp"
 #include "tools/link/sim_link.hpp"
 
-namespace aerie::faults {
+namespace aerie::loop::faults {
 
 enum class Kind { Kill, CameraStall, LinkDrop, LinkDegrade, Burst, NanPose };
 
@@ -141,4 +141,4 @@ class Injector {
   Counters counters_;
 };
 
-}  // namespace aerie::faults
+}  // namespace aerie::loop::faults

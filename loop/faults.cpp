@@ -1,4 +1,4 @@
-#include "tools/faults/faults.hpp"
+#include "loop/faults.hpp"
 
 #include <aerie/pose_t.hpp>
 #include <aerie/target_pose_t.hpp>
@@ -11,7 +11,7 @@
 
 #include "common/bus/wire.hpp"
 
-namespace aerie::faults {
+namespace aerie::loop::faults {
 
 namespace {
 
@@ -278,4 +278,4 @@ void Injector::nan_pose(const std::string& channel, Flight& flight) {
   throw std::invalid_argument("nan_pose: nothing was published on " + channel + " before the fault");
 }
 
-}  // namespace aerie::faults
+}  // namespace aerie::loop::faults

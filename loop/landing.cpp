@@ -1,20 +1,25 @@
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 
 #include <aerie/pilot_state_t.hpp>
 #include <aerie/target_pose_t.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <numbers>
+#include <sstream>
+#include <stdexcept>
 
 #include "air/mavlink/node/mavlink_node.hpp"
 #include "air/pilot/node/pilot_node.hpp"
+#include "air/pilot/pilot_config.hpp"
+#include "air/track/factory.hpp"
 #include "common/sim/autopilot/mavlink_face.hpp"
-#include "common/sim/flight/node/flightsim_node.hpp"
+#include "common/sim/flight/flight_config.hpp"
 
-namespace aerie::landing {
+namespace aerie::loop::landing {
 
 double RunResult::rmse(int axis, bool fitted_only) const {
   double s = 0;
@@ -56,7 +61,7 @@ namespace {
 class MavlinkPath {
  public:
   MavlinkPath(const RunConfig& config, bus::Bus& air, sim::FlightSim& simulator)
-      : sim_(simulator), face_(config.autopilot, sim::autopilot::airframe_params(config.sim.vehicle, config.sim.seed)) {
+      : sim_(simulator), face_(config.autopilot, sim::autopilot::airframe_params(config.sim.vehicle, config.seed)) {
     auto [bridge_end, vehicle_end] = mavlink::memory_pipe("mavlink");
     vehicle_ = std::move(vehicle_end);
     bridge::BridgeConfig bc = config.bridge;
@@ -64,7 +69,7 @@ class MavlinkPath {
     bc.takeoff_altitude_m = simulator.vehicle().params().takeoff_height_m;
     bc.camera_pitch_deg = config.pilot.camera_pitch_deg;
     mavlink::Key key{};
-    for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<uint8_t>(config.sim.seed * 131 + i * 7);
+    for (size_t i = 0; i < key.size(); ++i) key[i] = static_cast<uint8_t>(config.seed * 131 + i * 7);
     const util::NodeClock now = [&simulator] { return simulator.utime_of(simulator.time()); };
     bridge::AutopilotLink link(bc);
     link.enable_signing(key, 0, 0);
@@ -109,33 +114,26 @@ class MavlinkPath {
 }  // namespace
 
 RunResult fly(const RunConfig& config) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  sim::FlightSim simulator(config.sim);
-  link::SplitBus buses(config.split);
-  bus::Bus& air = buses.on(link::Side::kAir);
-  faults::Injector injector(config.faults, config.sim.seed);
-  buses.tap(injector.tap(config.on_message));
   sim::FlightSimNodeOptions so;
-  so.answer_channels.clear();  // a frame is answered when the buses are settled
   if (config.via != Via::Direct) so.command_channel.clear();  // the autopilot commands the vehicle
-  sim::FlightSimNode sim_node(air, simulator, so);
+  Harness harness(config, config.sim, so);
+  sim::FlightSim& simulator = harness.sim();
   track::NodeOptions to = config.track;
   to.every_frame = true;  // lock-step: every frame delivered is tracked
-  bus::Bus &track_bus = buses.of("track"), &pilot_bus = buses.of("pilot");
+  bus::Bus &track_bus = harness.bus_of("track"), &pilot_bus = harness.bus_of("pilot");
   faults::Respawnable<track::TrackNode> track_node(track_bus, [&] { return std::make_unique<track::TrackNode>(track_bus, to); });
   // The pilot's clock is the simulation's: its input-age rule sees the link's delay, not the machine's speed.
-  const util::NodeClock now = [&simulator] { return simulator.utime_of(simulator.time()); };
+  const util::NodeClock now = harness.clock();
   faults::Respawnable<pilot::PilotNode> pilot_node(
       pilot_bus, [&] { return std::make_unique<pilot::PilotNode>(pilot_bus, config.pilot, pilot::PilotNodeOptions{}, now); });
-  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }, {}};
-  flight.add("track", track_node);
-  flight.add("pilot", pilot_node);
-  auto wait_tracker = [&] {
+  harness.add("track", track_node);
+  harness.add("pilot", pilot_node);
+  harness.wait_workers([&] {
     if (track_node.get()) track_node.get()->wait_idle(60000);
-  };
+  });
   auto pilot_state = [&] { return pilot_node.get() ? pilot_node.get()->pilot().state() : pilot::State::Idle; };
   std::optional<MavlinkPath> mavlink;
-  if (config.via != Via::Direct) mavlink.emplace(config, air, simulator);  // the bridge flies with the vehicle
+  if (config.via != Via::Direct) mavlink.emplace(config, harness.air(), simulator);  // the bridge flies with the vehicle
 
   RunResult r;
   std::map<int64_t, sim::TargetTruth> truth;  // of the last frames, by utime
@@ -155,12 +153,12 @@ RunResult fly(const RunConfig& config) {
   }, 1000);
 
   int64_t end_frame = -1;
-  while (true) {
-    const sim::FlightFrame& f = sim_node.publish_next();
+  const auto remember = [&](const sim::FlightFrame& f) {
     truth[f.utime] = f.target;
     if (truth.size() > 400) truth.erase(truth.begin());  // 20 s at 20 Hz: longer than any link delay studied
-    injector.step(f.t, flight);
-    buses.settle(f.utime, wait_tracker);
+  };
+  while (true) {
+    const sim::FlightFrame& f = harness.step(remember);
     if (mavlink) mavlink->step();
     if (simulator.outcome().ended() && end_frame < 0) end_frame = f.seq;
     const pilot::State s = pilot_state();
@@ -179,7 +177,6 @@ RunResult fly(const RunConfig& config) {
     for (const char* ch : {"TARGET_POSE", "TRACK", "IMU"})
       r.pilot_refused += p->counter(std::string(ch) + "_refused") + p->counter(std::string(ch) + "_time_held");
   }
-  r.lockstep_timeouts = sim_node.lockstep_timeouts();
   if (track::TrackNode* t = track_node.get()) {
     t->wait_idle(5000);
     r.pad_refined = t->counter("pad_refined");
@@ -190,14 +187,79 @@ RunResult fly(const RunConfig& config) {
       if (const int64_t n = t->counter("pad_miss_" + track::to_string(miss)))
         r.pad_misses += (r.pad_misses.empty() ? "" : " ") + track::to_string(miss) + ":" + std::to_string(n);
   }
-  r.faults = injector.report(buses, sim_node.stalled_frames(), simulator.vehicle().command_timeouts());
-  r.commands_refused = simulator.commands_refused();
   if (mavlink) r.mavlink = mavlink->counters();
-  r.link_down = buses.down_counters();
-  r.link_up = buses.up_counters();
-  r.sim_s = simulator.time();
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  static_cast<RunStats&>(r) = harness.finish();
   return r;
 }
 
-}  // namespace aerie::landing
+LandingSpec load_landing_spec(const util::Config& section, const std::string& base_dir) {
+  section.check_keys({"sim", "track", "pilot", "tracker", "controller", "wind_m_s", "vibration", "max_time_s", "via", "autopilot"});
+  const auto path = [&](const std::string& f) { return f.starts_with('/') ? f : base_dir + "/" + f; };
+  const auto fail = [&](const std::string& key, const std::string& why) {
+    throw std::runtime_error(section.origin() + ": key '" + key + "': " + why);
+  };
+  LandingSpec s;
+  s.sim = path(section.get("sim", s.sim));
+  s.track = path(section.get("track", s.track));
+  s.pilot = path(section.get("pilot", s.pilot));
+  s.tracker = section.get("tracker", s.tracker);
+  if (!s.tracker.empty() && !track::is_known_tracker(s.tracker)) fail("tracker", "unknown tracker '" + s.tracker + "'");
+  s.controller = section.get("controller", s.controller);
+  if (!s.controller.empty() && s.controller != "fuzzy" && s.controller != "pid")
+    fail("controller", "expected fuzzy or pid, not '" + s.controller + "'");
+  if (section.has("wind_m_s")) s.wind_m_s = section.get_in("wind_m_s", 0.0, 0.0, 20.0);
+  if (section.has("vibration")) s.vibration = section.get("vibration", true);
+  if (section.has("max_time_s")) s.max_time_s = section.get_in("max_time_s", 90.0, 1.0, 3600.0);
+  try {
+    s.via = via_from_string(section.get<std::string>("via", to_string(s.via)));
+  } catch (const std::invalid_argument& e) {
+    fail("via", e.what());
+  }
+  const std::string autopilot = section.get<std::string>("autopilot", "px4");
+  if (autopilot != "px4" && autopilot != "ardupilot") fail("autopilot", "expected px4 or ardupilot, not '" + autopilot + "'");
+  s.autopilot = autopilot == "ardupilot" ? sim::autopilot::Personality::ArduCopter : sim::autopilot::Personality::Px4;
+  return s;
+}
+
+RunConfig load_landing_run(const LandingSpec& spec, uint64_t seed) {
+  RunConfig rc;
+  rc.seed = seed;
+  rc.sim = sim::load_flight_config(util::Config::load(spec.sim));
+  if (spec.wind_m_s) rc.sim.wind.mean_m_s = *spec.wind_m_s;
+  if (spec.vibration) rc.sim.vibration.enabled = *spec.vibration;
+  if (spec.max_time_s) rc.sim.max_time_s = *spec.max_time_s;
+  rc.sim.seed = seed;
+  rc.track = track::node_options(util::Config::load(spec.track));
+  if (!spec.tracker.empty()) rc.track.tracker = spec.tracker;
+  rc.track.seed = seed;
+  rc.pilot = load_landing_pilot(spec);
+  rc.via = spec.via;
+  rc.autopilot = spec.autopilot;
+  return rc;
+}
+
+pilot::PilotConfig load_landing_pilot(const LandingSpec& spec) {
+  if (spec.pilot_yaml.empty() && spec.controller.empty()) return pilot::load_pilot_config(util::Config::load(spec.pilot));
+  std::string text = spec.pilot_yaml;
+  if (text.empty()) {
+    std::ifstream f(spec.pilot);
+    if (!f) throw std::runtime_error(spec.pilot + ": cannot read the pilot configuration");
+    std::stringstream all;
+    all << f.rdbuf();
+    text = all.str();
+  }
+  if (!spec.controller.empty()) {
+    YAML::Node yaml = YAML::Load(text);
+    yaml["controller"] = spec.controller;
+    YAML::Emitter out;
+    out << yaml;
+    text = out.c_str();
+  }
+  return pilot::load_pilot_config(util::Config::parse(text, spec.pilot));
+}
+
+RunConfig load_landing_run(const util::Config& section, uint64_t seed, const std::string& base_dir) {
+  return load_landing_run(load_landing_spec(section, base_dir), seed);
+}
+
+}  // namespace aerie::loop::landing

@@ -1,4 +1,4 @@
-#include "tools/avoidance/avoidance_run.hpp"
+#include "loop/avoidance.hpp"
 
 #include <aerie/control_cmd_t.hpp>
 #include <aerie/pose_t.hpp>
@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -16,10 +15,9 @@
 #include "common/bus/status.hpp"
 #include "common/flc/flc_io.hpp"
 #include "common/sim/flight/flight_config.hpp"
-#include "common/sim/flight/node/flightsim_node.hpp"
 #include "common/sim/vehicle/scenario_config.hpp"
 
-namespace aerie::avoidance {
+namespace aerie::loop::avoidance {
 
 namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -59,7 +57,7 @@ const char* source_name(Source source) {
   return "?";
 }
 
-RunConfig load_run_config(const util::Config& cfg, const std::string& base_dir) {
+RunConfig load_avoidance_run(const util::Config& cfg, const std::string& base_dir) {
   const auto file = [&](const char* key) {
     const std::string f = cfg.get<std::string>(key, std::string("config/") + key + ".yaml");
     return util::Config::load(f.starts_with('/') ? f : base_dir + "/" + f);
@@ -92,14 +90,14 @@ flc::FlcSpec controller_named(const std::string& name, const std::string& base_d
   return flc::load_controller(bare ? base_dir + "/config/flc/" + name + ".yaml" : name);
 }
 
-RunResult fly(const RunConfig& config, uint64_t seed) {
-  const auto wall0 = std::chrono::steady_clock::now();
+RunResult fly(const RunConfig& config) {
   RunResult r;
   sim::FlightSimConfig sc = config.sim;
-  sc.seed = seed;
   sc.stereo = config.source != Source::kGt;  // the truth needs no images
-  sim::FlightSim simulator(sc);
-  const util::NodeClock now = [&simulator] { return simulator.utime_of(simulator.time()); };
+  // Every node below answers on this thread: the buses settled = the frame answered.
+  Harness harness(config, sc);
+  sim::FlightSim& simulator = harness.sim();
+  const util::NodeClock now = harness.clock();
 
   // The scene, measured from the start along its heading; the wall must be where it says.
   const sim::MultirotorState start = simulator.vehicle().state();
@@ -109,15 +107,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     throw std::invalid_argument("avoidance: the surface ahead of the start is " + (hit ? std::to_string(hit->t) : "none") +
                                 " m away; scene.wall_m is " + std::to_string(config.scene.wall_y_m));
 
-  link::SplitBus buses(config.split);
-  bus::Bus& air = buses.on(link::Side::kAir);
-  faults::Injector injector(config.faults, seed);
-  buses.tap(injector.tap(config.on_message));
-  sim::FlightSimNodeOptions so;
-  so.answer_channels.clear();  // every node below answers on this thread: the buses settled = answered
-  sim::FlightSimNode sim_node(air, simulator, so);
-
-  bus::Bus &vo_bus = buses.of("vo"), &nav_bus = buses.of("nav"), &control_bus = buses.of("control");
+  bus::Bus &vo_bus = harness.bus_of("vo"), &nav_bus = harness.bus_of("nav"), &control_bus = harness.bus_of("control");
   bus::StatusReporter vo_status(vo_bus, "vo"), control_status(control_bus, "control");
   std::optional<faults::Respawnable<stereo::VoNode>> vo_node;
   std::optional<faults::Respawnable<nav::NavNode>> nav_node;
@@ -155,10 +145,9 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
     nav_node.emplace(nav_bus, [&] { return std::make_unique<nav::NavNode>(nav_bus, nc); });
   faults::Respawnable<control::ControlNode> control_node(
       control_bus, [&] { return std::make_unique<control::ControlNode>(control_bus, control_status, config.controller, co, now); });
-  faults::Flight flight{&buses, [&](bool stalled) { sim_node.stall_cameras(stalled); }, {}};
-  flight.add("control", control_node);
-  if (vo_node) flight.add("vo", *vo_node);
-  if (nav_node) flight.add("nav", *nav_node);
+  harness.add("control", control_node);
+  if (vo_node) harness.add("vo", *vo_node);
+  if (nav_node) harness.add("nav", *nav_node);
 
   vo_bus.subscribe<aerie::pose_t>(config.vo.pose, [&](const aerie::pose_t& m, const bus::ReceiveInfo&) {
     ++r.vo_poses;
@@ -176,9 +165,7 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   std::optional<double> estimate_offset;  // estimate - truth at aerie-control's first input
   int64_t est_n = 0;
   while (true) {
-    const sim::FlightFrame& f = sim_node.publish_next();
-    injector.step(f.t, flight);
-    buses.settle(f.utime);
+    const sim::FlightFrame& f = harness.step();
     Sample s;
     s.t = f.t;
     const Eigen::Vector2d d = f.vehicle.position.head<2>() - start.position.head<2>();
@@ -216,14 +203,8 @@ RunResult fly(const RunConfig& config, uint64_t seed) {
   r.min_wall_distance_m = config.scene.wall_y_m - max_travel;
   if (est_n) r.estimate_rmse_deg = std::sqrt(est_sq / static_cast<double>(est_n));
   if (nav_node && nav_node->get()) r.nav_gated = nav_node->get()->filter().counters().vo_gated;
-  r.faults = injector.report(buses, sim_node.stalled_frames(), simulator.vehicle().command_timeouts());
-  r.lockstep_timeouts = sim_node.lockstep_timeouts();
-  r.commands_refused = simulator.commands_refused();
-  r.link_down = buses.down_counters();
-  r.link_up = buses.up_counters();
-  r.sim_s = simulator.time();
-  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  static_cast<RunStats&>(r) = harness.finish();
   return r;
 }
 
-}  // namespace aerie::avoidance
+}  // namespace aerie::loop::avoidance

@@ -6,24 +6,16 @@
 #include <string>
 #include <vector>
 
-#include "air/pilot/pilot_config.hpp"
-#include "common/sim/flight/flight_config.hpp"
 #include "tests/support/lockstep_bytes.hpp"
-#include "tools/landing/landing_run.hpp"
+#include "loop/landing.hpp"
 
 using namespace aerie;
 
 namespace {
 
-landing::RunConfig config(const std::string& tracker, uint64_t seed) {
-  landing::RunConfig rc;
-  rc.sim = sim::load_flight_config(util::Config::load(AERIE_SOURCE_DIR "/config/sim/landing_room.yaml"));
-  rc.sim.seed = seed;
-  rc.sim.max_time_s = 60;
-  rc.track = track::node_options(util::Config::load(AERIE_SOURCE_DIR "/config/track_landing.yaml"));
-  rc.track.tracker = tracker;
-  rc.pilot = pilot::load_pilot_config(util::Config::load(AERIE_SOURCE_DIR "/config/pilot.yaml"));
-  return rc;
+loop::landing::RunConfig config(const std::string& tracker, uint64_t seed) {
+  return loop::landing::load_landing_run(
+      util::Config::parse("tracker: " + tracker + "\nmax_time_s: 60\n", "test_landing_loop"), seed, AERIE_SOURCE_DIR);
 }
 
 struct Message {
@@ -33,12 +25,12 @@ struct Message {
 };
 
 // Every message of a run; TRACK with its processing time (wall clock) zeroed.
-std::vector<Message> record(landing::RunConfig rc, landing::RunResult* result = nullptr) {
+std::vector<Message> record(loop::landing::RunConfig rc, loop::landing::RunResult* result = nullptr) {
   std::vector<Message> out;
   rc.on_message = [&](link::Side, const std::string& channel, const uint8_t* data, size_t size, int64_t) {
     out.push_back(Message{channel, test::comparable_bytes(channel, data, size)});
   };
-  const landing::RunResult r = landing::fly(rc);
+  const loop::landing::RunResult r = loop::landing::fly(rc);
   if (result) *result = r;
   return out;
 }
@@ -46,10 +38,10 @@ std::vector<Message> record(landing::RunConfig rc, landing::RunResult* result = 
 }  // namespace
 
 TEST(LandingLoop, LockStepRunsWithTheSameSeedGiveTheSameMessages) {
-  landing::RunConfig rc = config("amcmr-ct", 5);
+  loop::landing::RunConfig rc = config("amcmr-ct", 5);
   rc.sim.wind.mean_m_s = 1.0;
   rc.sim.vibration.enabled = true;
-  landing::RunResult ra, rb;
+  loop::landing::RunResult ra, rb;
   const std::vector<Message> a = record(rc, &ra), b = record(rc, &rb);
   ASSERT_TRUE(ra.outcome.ended());
   EXPECT_EQ(ra.lockstep_timeouts, 0);
@@ -70,11 +62,11 @@ TEST(LandingLoop, LockStepRunsWithTheSameSeedGiveTheSameMessages) {
 class LandingPerTracker : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LandingPerTracker, LandsOnThePad) {
-  landing::RunConfig rc = config(GetParam(), 2);
+  loop::landing::RunConfig rc = config(GetParam(), 2);
   rc.sim.placement.start_distance_min_m = 0.5;
   rc.sim.placement.start_distance_max_m = 1.0;
   rc.pilot.survey_legs.clear();
-  const landing::RunResult r = landing::fly(rc);
+  const loop::landing::RunResult r = loop::landing::fly(rc);
   EXPECT_TRUE(r.outcome.landed) << r.final_state << " " << r.outcome.collision;
   EXPECT_TRUE(r.score.success) << "touchdown error " << r.score.touchdown_error_m << " m, yaw " << r.score.yaw_error_deg;
   EXPECT_LT(r.score.touchdown_error_m, 0.15);
@@ -98,25 +90,25 @@ INSTANTIATE_TEST_SUITE_P(Families, LandingPerTracker, ::testing::Values("ipsl-mr
 // The product through MAVLink: aerie-mavlink's node and the simulator's autopilot (PX4 and
 // ArduCopter) joined by a signed MAVLink 2 byte stream, in lock-step.
 struct ViaCase {
-  landing::Via via;
+  loop::landing::Via via;
   sim::autopilot::Personality autopilot;
 };
 
 class LandingThroughMavlink : public ::testing::TestWithParam<ViaCase> {};
 
 TEST_P(LandingThroughMavlink, LandsOnThePadAndRepeatsItselfExactly) {
-  landing::RunConfig rc = config("amcmr-ct", 3);
+  loop::landing::RunConfig rc = config("amcmr-ct", 3);
   rc.sim.wind.mean_m_s = 1.0;
   rc.sim.vibration.enabled = true;
   rc.via = GetParam().via;
   rc.autopilot = GetParam().autopilot;
-  landing::RunResult ra, rb;
+  loop::landing::RunResult ra, rb;
   const std::vector<Message> a = record(rc, &ra), b = record(rc, &rb);
   EXPECT_TRUE(ra.score.success) << ra.final_state << ", autopilot " << ra.mavlink.autopilot_mode;  // on the pad, in time
   EXPECT_EQ(ra.mavlink.frames_refused, 0);      // every frame of both sides verified
   EXPECT_EQ(ra.mavlink.commands_timed_out, 0);
   EXPECT_GT(ra.mavlink.commands_accepted, 3);   // arm, take-off, mode, land at least
-  if (rc.via == landing::Via::MavlinkOffboard) {
+  if (rc.via == loop::landing::Via::MavlinkOffboard) {
     EXPECT_GT(ra.mavlink.setpoints, 100);
   } else {
     EXPECT_GT(ra.mavlink.landing_targets, 5);  // the autopilot landed on Aerie's LANDING_TARGET
@@ -131,11 +123,11 @@ TEST_P(LandingThroughMavlink, LandsOnThePadAndRepeatsItselfExactly) {
 
 INSTANTIATE_TEST_SUITE_P(
     Paths, LandingThroughMavlink,
-    ::testing::Values(ViaCase{landing::Via::MavlinkOffboard, sim::autopilot::Personality::Px4},
-                      ViaCase{landing::Via::MavlinkPrecland, sim::autopilot::Personality::Px4},
-                      ViaCase{landing::Via::MavlinkOffboard, sim::autopilot::Personality::ArduCopter},
-                      ViaCase{landing::Via::MavlinkPrecland, sim::autopilot::Personality::ArduCopter}),
+    ::testing::Values(ViaCase{loop::landing::Via::MavlinkOffboard, sim::autopilot::Personality::Px4},
+                      ViaCase{loop::landing::Via::MavlinkPrecland, sim::autopilot::Personality::Px4},
+                      ViaCase{loop::landing::Via::MavlinkOffboard, sim::autopilot::Personality::ArduCopter},
+                      ViaCase{loop::landing::Via::MavlinkPrecland, sim::autopilot::Personality::ArduCopter}),
     [](const ::testing::TestParamInfo<ViaCase>& info) {
-      return std::string(info.param.via == landing::Via::MavlinkOffboard ? "Offboard" : "Precland") +
+      return std::string(info.param.via == loop::landing::Via::MavlinkOffboard ? "Offboard" : "Precland") +
              (info.param.autopilot == sim::autopilot::Personality::Px4 ? "Px4" : "ArduCopter");
     });
