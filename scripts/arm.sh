@@ -26,14 +26,17 @@ mmdebstrap from the Debian archive this machine's apt already uses.
   --setup-only   install the host packages and make the sysroot, nothing else
   --all          also run the 3 procman tests that fail under qemu-user only (no
                  PR_SET_CHILD_SUBREAPER in qemu 7.2; docs/arm.md), left out by default
+  --no-landing   leave out the lock-step landing flown after the tests
   -- ARGS        passed to ctest (e.g. -- -R simd -V)
 
 After the tests it runs test_simd_dispatch again on a NEON-only CPU (arm64: cortex-a72) so the
-log shows both the SVE and the NEON path of every Highway-dispatched kernel.
+log shows both the SVE and the NEON path of every Highway-dispatched kernel, then (arm64) flies one
+seeded lock-step landing with the target's aerie-flightsim, aerie-track and aerie-pilot under
+qemu (in a network namespace of its own; about 2 minutes): it fails the run unless it lands.
 EOF
 }
 
-arch=arm64 sysroot="" jobs=2 run_tests=1 cpu="" setup_only=0 run_all=0 ctest_args=()
+arch=arm64 sysroot="" jobs=2 run_tests=1 cpu="" setup_only=0 run_all=0 run_landing=1 ctest_args=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --arch) arch=$2; shift 2 ;;
@@ -43,6 +46,7 @@ while [ $# -gt 0 ]; do
     --cpu) cpu=$2; shift 2 ;;
     --setup-only) setup_only=1; shift ;;
     --all) run_all=1; shift ;;
+    --no-landing) run_landing=0; shift ;;
     -h|--help) usage; exit 0 ;;
     --) shift; ctest_args=("$@"); break ;;
     *) echo "arm.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
@@ -71,7 +75,7 @@ HOST_PACKAGES=(cmake ninja-build pkg-config liblcm-bin python3 "g++-$triplet" qe
 SYSROOT_PACKAGES=(libc6-dev libstdc++-12-dev libopencv-dev libopencv-contrib-dev libeigen3-dev
                   libceres-dev libblas-dev liblapack-dev liblcm-dev libglib2.0-dev libhwy-dev
                   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libgtest-dev libgmock-dev
-                  libfuzzylite-dev libsodium-dev)
+                  libfuzzylite-dev libsodium-dev libapriltag-dev)
 
 need_root() {
   if [ "$(id -u)" -ne 0 ]; then
@@ -244,6 +248,38 @@ if [ -z "$cpu" ] && [ -x "build/$preset/tests/test_simd_dispatch" ]; then
   log "Highway dispatch on a NEON-only CPU (QEMU_CPU=$neon_cpu):"
   QEMU_CPU=$neon_cpu QEMU_LD_PREFIX=$sysroot "$qemu" -L "$sysroot" "build/$preset/tests/test_simd_dispatch" \
     --gtest_brief=1 || status=$?
+fi
+# One closed-loop landing on the air side's architecture (issue 50, section 5): the target's
+# binaries under qemu over LCM in a network namespace of their own (multicast on its loopback
+# only), in lock-step: the simulator's next frame waits for the tracker's TRACK and the pilot's
+# CTRL_CMD. Seed 2 of config/sim/landing_room.yaml; the flightsim's one-line result decides.
+landing_check() {
+  local ns=aerie-arm-landing-$$ dir=build/$preset/landing url="udpm://239.255.76.67:7667?ttl=0" t p rc=0
+  if [ "$(id -u)" -ne 0 ] || ! ip netns add "$ns" 2>/dev/null; then
+    log "landing under qemu left out: it needs root for its network namespace"
+    return 0
+  fi
+  mkdir -p "$dir"
+  rm -f "$dir/result.txt"
+  ip netns exec "$ns" ip link set lo up
+  ip netns exec "$ns" ip route add 224.0.0.0/4 dev lo
+  local run=(ip netns exec "$ns" env LCM_DEFAULT_URL="$url" QEMU_LD_PREFIX="$sysroot" "$qemu" -L "$sysroot")
+  log "lock-step landing under ${qemu} (seed 2, config/sim/landing_room.yaml)"
+  "${run[@]}" "build/$preset/bin/aerie-track" --config config/track_landing.yaml --log-level warn >"$dir/track.log" 2>&1 &
+  t=$!
+  "${run[@]}" "build/$preset/bin/aerie-pilot" --config config/pilot.yaml --log-level warn >"$dir/pilot.log" 2>&1 &
+  p=$!
+  sleep 5  # both subscribed before the first frame
+  timeout 600 "${run[@]}" "build/$preset/bin/aerie-flightsim" --config config/sim/landing_room.yaml --mode lockstep \
+    --answer TRACK CTRL_CMD --seed 2 --result "$dir/result.txt" --log-level warn >"$dir/flightsim.log" 2>&1 || rc=$?
+  kill "$t" "$p" 2>/dev/null || true
+  wait "$t" "$p" 2>/dev/null || true
+  ip netns del "$ns"
+  log "landing: $(cat "$dir/result.txt" 2>/dev/null || echo "no result (flightsim exit $rc; logs in $dir)")"
+  grep -q "^LANDED (success)" "$dir/result.txt" 2>/dev/null
+}
+if [ "$run_landing" -eq 1 ] && [ "$arch" = arm64 ]; then
+  landing_check || status=1
 fi
 log "total $(( $(date +%s) - start )) s"
 exit $status

@@ -15,7 +15,7 @@ WorldConfig load_world_config(const util::Config& c) {
   using W = WorldConfig;
   SectionReader<W>(c, w)("kind", &W::kind)("seed", &W::seed)("room_x", &W::room_x)("room_y", &W::room_y)(
       "room_z", &W::room_z)("n_obstacles", &W::n_obstacles)("helipad_size", &W::helipad_size)(
-      "helipad_yaw_deg", &W::helipad_yaw_deg)("helipad_x", &W::helipad_x)("helipad_y", &W::helipad_y)(
+      "helipad_yaw_deg", &W::helipad_yaw_deg)("helipad_x", &W::helipad_x)("helipad_y", &W::helipad_y)("helipad_image", &W::helipad_image)(
       "texels_per_metre", &W::texels_per_metre)("route_margin", &W::route_margin)(
       "route_clearance", &W::route_clearance)("cruise_altitude", &W::cruise_altitude)("field_x", &W::field_x)(
       "field_y", &W::field_y)("sky_z", &W::sky_z)("field_texels_per_metre", &W::field_texels_per_metre)(

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -78,10 +79,35 @@ std::vector<Eigen::Vector2d> route_samples(const World::Route& r, const Helipad&
   return pts;
 }
 
-// Paints the helipad (dark square, white ring, white H) into the texture of an upward-facing
-// surface (the room's floor, the top of the field's landing object), with 4x4 supersampling
-// per texel for anti-aliased edges.
-void paint_helipad(cv::Mat& tex, const Surface& floor, const Helipad& pad, double density) {
+// The helipad_image option: a binary Netpbm image (P5 gray or P6 RGB, maxval 255) as 8-bit gray.
+// aerie_sim links no image codec library; Netpbm needs none.
+cv::Mat read_helipad_image(const std::string& path) {
+  auto bad = [&](const std::string& what) { throw std::invalid_argument("sim::WorldConfig: helipad_image '" + path + "': " + what); };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) bad("cannot be read");
+  std::string magic;
+  in >> magic;
+  if (magic != "P5" && magic != "P6") bad("not a binary PGM (P5) or PPM (P6) image");
+  int fields[3] = {0, 0, 0};  // width, height, maxval
+  for (int& f : fields) {
+    while (in >> std::ws && in.peek() == '#') in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    if (!(in >> f)) bad("truncated header");
+  }
+  in.get();  // the single whitespace before the pixels
+  if (fields[0] < 8 || fields[1] < 8 || fields[0] > 8192 || fields[1] > 8192) bad("width and height must be in [8, 8192]");
+  if (fields[2] != 255) bad("maxval must be 255 (8 bit)");
+  const int channels = magic == "P5" ? 1 : 3;
+  cv::Mat img(fields[1], fields[0], channels == 1 ? CV_8UC1 : CV_8UC3);
+  for (int r = 0; r < img.rows; ++r)
+    if (!in.read(reinterpret_cast<char*>(img.ptr(r)), static_cast<std::streamsize>(img.cols) * channels)) bad("truncated pixels");
+  if (channels == 3) cv::cvtColor(img, img, cv::COLOR_RGB2GRAY);
+  return img;
+}
+
+// Paints the helipad (dark square, white ring, white H; or `image` over the square) into the
+// texture of an upward-facing surface (the room's floor, the top of the field's landing object),
+// with 4x4 supersampling per texel for anti-aliased edges.
+void paint_helipad(cv::Mat& tex, const Surface& floor, const Helipad& pad, double density, const cv::Mat& image) {
   CV_Assert(floor.axis == 2 && floor.normal_sign == 1 && floor.u_axis == 0 && floor.v_sign == -1);
   const double s = pad.size;
   const double half = 0.5 * s * std::sqrt(2.0) + 0.02;
@@ -98,6 +124,11 @@ void paint_helipad(cv::Mat& tex, const Surface& floor, const Helipad& pad, doubl
   auto marking = [&](double lx, double ly) -> double {
     const double ax = std::abs(lx), ay = std::abs(ly);
     if (ax > 0.5 || ay > 0.5) return -1.0;
+    if (!image.empty()) {  // nearest image pixel: column along +x, row along -y
+      const int c = std::min(image.cols - 1, static_cast<int>((lx + 0.5) * image.cols));
+      const int r = std::min(image.rows - 1, static_cast<int>((0.5 - ly) * image.rows));
+      return image.at<uint8_t>(r, c) / 255.0;
+    }
     const double r = std::hypot(lx, ly);
     if (r > 0.40 && r < 0.46) return 1.0;  // ring
     // "H": two vertical legs and a bar; the bar runs along local x.
@@ -277,6 +308,7 @@ World World::room(const WorldConfig& cfg) {
   check(cfg.cruise_altitude > 0.3 && cfg.cruise_altitude < cfg.room_z - 0.3,
         "cruise_altitude must be at least 0.3 m from floor and ceiling");
   check(unset_or_finite(cfg.helipad_x) && unset_or_finite(cfg.helipad_y), "helipad_x, helipad_y must be finite");
+  const cv::Mat pad_image = cfg.helipad_image.empty() ? cv::Mat() : read_helipad_image(cfg.helipad_image);
 
   World w;
   w.config_ = cfg;
@@ -335,7 +367,7 @@ World World::room(const WorldConfig& cfg) {
             1000 + 6 * i + 2 * axis + side);
       }
   }
-  paint_helipad(images[4], w.surfaces_[4], w.helipad_, density);  // surface 4: the floor
+  paint_helipad(images[4], w.surfaces_[4], w.helipad_, density, pad_image);  // surface 4: the floor
   // Ceiling lamps on a ~3 m grid (none inside a pillar); the ceiling itself is lit only by
   // the ambient term, its light panels are in its texture.
   Lighting light;
@@ -388,6 +420,7 @@ World World::field(const WorldConfig& cfg) {
   check(unset_or_finite(cfg.sun_azimuth_deg), "sun_azimuth_deg must be finite");
   check(cfg.n_obstacles >= 0, "n_obstacles must be >= 0");
   check(cfg.helipad_size > 0.1, "helipad_size must be > 0.1 m");
+  const cv::Mat pad_image = cfg.helipad_image.empty() ? cv::Mat() : read_helipad_image(cfg.helipad_image);
   check(cfg.route_margin >= 0.5 && 2 * cfg.route_margin < std::min(cfg.field_x, cfg.field_y) - 1.0,
         "route_margin must be >= 0.5 m and leave at least 1 m of route");
   check(cfg.cruise_altitude >= cfg.vehicle_height + 0.5 && cfg.cruise_altitude <= cfg.sky_z - 0.3,
@@ -486,7 +519,7 @@ World World::field(const WorldConfig& cfg) {
       }
   }
   const int top = kBoundaryFaces + 6 * w.landing_ + 5;  // the landing object's top face
-  paint_helipad(images[top], w.surfaces_[top], w.helipad_, densities[top]);
+  paint_helipad(images[top], w.surfaces_[top], w.helipad_, densities[top], pad_image);
 
   // Sunlight with hard shadows plus sky light; the sky faces are emissive (not lit).
   const double az = (std::isnan(cfg.sun_azimuth_deg) ? sun_az : cfg.sun_azimuth_deg) * kPi / 180.0;
@@ -502,6 +535,25 @@ World World::field(const WorldConfig& cfg) {
     textures->surfaces.emplace_back(images[k], densities[k]);
   }
   w.textures_ = std::move(textures);
+  return w;
+}
+
+World World::with_landing_offset(const Eigen::Vector2d& offset) const {
+  if (landing_ < 0)
+    throw std::invalid_argument("sim::World: a moving platform needs world.kind field (the room's helipad is the floor)");
+  World w = *this;
+  const Eigen::Vector3d d(offset.x(), offset.y(), 0.0);
+  Aabb& box = w.obstacles_[landing_].box;
+  box.min += d;
+  box.max += d;
+  w.helipad_.center += d;
+  // Its six faces: the plane moves along its axis, the texture origin along the face.
+  for (int k = 0; k < 6; ++k) {
+    Surface& s = w.surfaces_[kBoundaryFaces + 6 * landing_ + k];
+    if (s.axis < 2) s.offset += d[s.axis];
+    if (s.u_axis < 2) s.u0 += d[s.u_axis];
+    if (s.v_axis < 2) s.v0 += d[s.v_axis];
+  }
   return w;
 }
 

@@ -37,6 +37,10 @@ struct WorldConfig {
   int n_obstacles = 6;            // boxes and pillars (trees in the field), clear of the route
   double helipad_size = 1.0;      // side of the square helipad marking (m)
   double helipad_yaw_deg = 0.0;   // rotation of the marking about z
+  // An image painted over the helipad's square instead of the H (helipad_size wide; column =
+  // the pad's +x, row = its -y; white paint where the image is white, the pad's dark where it is
+  // black): a binary Netpbm file (PGM P5 or PPM P6, 8 bit). Empty: the built-in H.
+  std::string helipad_image;
   // Helipad centre in xy (NaN = default: room x = 0.4 * route x_max, y = home y; field: a
   // seeded place in the central half). In the field the landing object stands centred under it.
   double helipad_x = kAuto;
@@ -128,6 +132,11 @@ class World {
   const Obstacle* landing_object() const { return landing_ < 0 ? nullptr : &obstacles_[landing_]; }
   // Unit vector towards the sun (zero in the room, which is lit by lamps).
   const Eigen::Vector3d& sun_direction() const { return sun_; }
+  // This world with the field's landing object, its faces, textures and the helipad moved by
+  // `offset` (m) in xy: the moving platform at one instant (common/sim/flight/platform.hpp).
+  // The lighting baked into the ground (the car's shadow) stays where the car was built.
+  // Throws std::invalid_argument in the room (its helipad is painted on the floor).
+  World with_landing_offset(const Eigen::Vector2d& offset) const;
 
   // True inside an obstacle or outside the room interior (walls, and the field's sky faces,
   // are solid: the geometry is exactly what the renderer draws).

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "air/track/landing/pad_fit.hpp"
 #include "air/track/tracker.hpp"
 
 namespace aerie::track {
@@ -32,14 +33,15 @@ constexpr int kTop = 48;  // side of the top view the marking is compared in (px
 using Quad = std::array<cv::Point2f, 4>;
 
 constexpr double kHx = 0.19, kHy = 0.24;  // half extent of the H along pad x and y (fraction of the size)
+constexpr double kLegIn = 0.11;           // inner edge of the H's legs along pad x (fraction of the size)
 
 // The marking at pad coordinates normalised by its size (paint_helipad in common/sim/world.cpp):
 // 1 white, 0 dark; the H's bar along x.
 double marking(double x, double y, double border) {
   const double ax = std::abs(x), ay = std::abs(y), r = std::hypot(x, y);
   const bool ring = r > 0.40 && r < 0.46;
-  const bool leg = ay < kHy && ax > 0.11 && ax < kHx;
-  const bool bar = ax < 0.11 && ay < 0.035;
+  const bool leg = ay < kHy && ax > kLegIn && ax < kHx;
+  const bool bar = ax < kLegIn && ay < 0.035;
   const bool edge = ax > 0.5 - border || ay > 0.5 - border;
   return ring || leg || bar || edge ? 1.0 : 0.0;
 }
@@ -76,12 +78,12 @@ double correlation(const cv::Mat& a, const cv::Mat& b) {
 
 // The quad (corners clockwise in the image) warped to a kTop x kTop top view, q[0] at its
 // top left and q[1] at its top right.
-cv::Mat top_view(const cv::Mat& gray, const Quad& q) {
-  const float e = kTop - 0.5f;
+cv::Mat top_view(const cv::Mat& gray, const Quad& q, int side = kTop) {
+  const float e = side - 0.5f;
   const std::array<cv::Point2f, 4> top{{{-0.5f, -0.5f}, {e, -0.5f}, {e, e}, {-0.5f, e}}};
   const cv::Mat H = cv::getPerspectiveTransform(top.data(), q.data());
   cv::Mat view;
-  cv::warpPerspective(gray, view, H, {kTop, kTop}, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  cv::warpPerspective(gray, view, H, {side, side}, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
   view.convertTo(view, CV_32F);
   return view;
 }
@@ -226,10 +228,14 @@ double edge_offset(const cv::Mat& gray, cv::Point2d base, cv::Point2d d, cv::Poi
 // the derivative's peak); a line fitted to these points robustly (Huber) per side; the corners
 // are the intersections of adjacent lines. Edges are better located than corners: clutter
 // next to a corner or the thin white border do not pull them. False when a side has too
-// few edge points. bright_inside: the H's rectangle instead (bright-to-dark steps, sampled
-// along the whole side: its short sides are the legs' ends, the gap between them has no step).
+// few edge points. bright_inside: the H's rectangle instead (bright-to-dark steps), its long
+// sides (the legs' outer edges) sampled along 94 %, its short sides (q[0] -> q[1] and
+// q[2] -> q[3], along the bar: the two legs' ends) only along the legs' ends. The gap between
+// the legs has no step of the H's: sampled, its points lock onto whatever lies beyond (a floor
+// mark next to the gap gave a second line and a skewed side; docs/arm.md, "PadPose on arm64").
 bool refine_sides(const cv::Mat& gray, Quad& q, double reach_fraction, double border = -1, bool bright_inside = false) {
-  const double polarity = bright_inside ? -1 : 1, span = bright_inside ? 0.94 : 0.7, start = bright_inside ? 0.03 : 0.15;
+  const double polarity = bright_inside ? -1 : 1;
+  constexpr double kLegEnd = (kHx - kLegIn) / (2 * kHx);  // a leg's end, fraction of the short side
   std::array<cv::Vec4f, 4> lines;  // (dx, dy, x0, y0)
   for (int i = 0; i < 4; ++i) {
     const cv::Point2d a(q[i]), b(q[(i + 1) % 4]);
@@ -240,9 +246,15 @@ bool refine_sides(const cv::Mat& gray, Quad& q, double reach_fraction, double bo
     std::vector<cv::Point2f> edge;
     int first_third = 0, last_third = 0;  // edge points near each end of the side
     std::vector<double> profile(steps + 1);
+    const bool leg_ends = bright_inside && i % 2 == 0;
+    // Sampled stretch: [start, start + span], or for the legs' ends its two halves moved apart
+    // to [0.03, kLegEnd - 0.03] and [1 - kLegEnd + 0.03, 0.97].
+    const double span = leg_ends ? 2 * (kLegEnd - 0.06) : bright_inside ? 0.94 : 0.7;
+    const double start = bright_inside ? 0.03 : 0.15, gap = leg_ends ? 1 - 2 * kLegEnd + 0.06 : 0;
     const int samples = std::min(100, static_cast<int>(span * len));
     for (int k = 0; k < samples; ++k) {
-      const cv::Point2d p = a + d * len * (start + span * (k + 0.5) / samples);
+      const double t = span * (k + 0.5) / samples;
+      const cv::Point2d p = a + d * len * (start + t + (t > span / 2 ? gap : 0));
       bool inside = true;
       for (int j = 0; j <= steps && inside; ++j) {
         const cv::Point2d s = p + n * (-reach + 0.5 * j);
@@ -293,7 +305,7 @@ void make_clockwise(Quad& q) {
   if (area2 < 0) std::reverse(q.begin(), q.end());
 }
 
-void check(const char* who, const cv::Mat& gray, const camera::CameraModel& cam, const PadGeometry& pad) {
+void check(const char* who, const cv::Mat& gray, const camera::CameraModel& cam, const PadGeometry* pad) {
   auto bad = [&](const std::string& what) { throw std::invalid_argument(who + (": " + what)); };
   if (gray.empty()) bad("empty frame");
   if (!(std::isfinite(cam.fx) && std::isfinite(cam.fy) && cam.fx > 0 && cam.fy > 0))
@@ -302,8 +314,9 @@ void check(const char* who, const cv::Mat& gray, const camera::CameraModel& cam,
   if ((cam.width > 0 || cam.height > 0) && cam.size() != gray.size())
     bad("camera is " + std::to_string(cam.width) + "x" + std::to_string(cam.height) + ", the frame " +
         std::to_string(gray.cols) + "x" + std::to_string(gray.rows));
-  if (!(pad.size > 0) || !std::isfinite(pad.size)) bad("pad size must be > 0 metres");
-  if (!(pad.border >= 0 && pad.border < 0.25)) bad("pad border must be in [0, 0.25) of the size");
+  if (!pad) return;
+  if (!(pad->size > 0) || !std::isfinite(pad->size)) bad("pad size must be > 0 metres");
+  if (!(pad->border >= 0 && pad->border < 0.25)) bad("pad border must be in [0, 0.25) of the size");
 }
 
 // Top view of the H's rectangle (kTop x kTop, column = +x over the bar, row = -y).
@@ -381,7 +394,7 @@ cv::Rect window_in(const cv::Rect2d& search, const cv::Mat& gray) {
 std::optional<PadObservation> observe(bool h_only, const cv::Mat& frame, const cv::Rect2d& search,
                                       const camera::CameraModel& camera, const PadGeometry& pad, const PadOptions& opt,
                                       PadMiss* miss) {
-  check(h_only ? "observe_marking" : "observe_pad", frame, camera, pad);
+  check(h_only ? "observe_marking" : "observe_pad", frame, camera, &pad);
   const cv::Mat gray = to_gray(frame);
   const cv::Rect win = window_in(search, gray);
   if (!std::isfinite(search.area()) || win.width < 2 * opt.min_side_px || win.height < 2 * opt.min_side_px) {
@@ -440,6 +453,22 @@ std::optional<PadObservation> observe(bool h_only, const cv::Mat& frame, const c
 }
 
 }  // namespace
+
+namespace detail {
+
+bool refine_dark_quad(const cv::Mat& gray, Quad& q, double reach_fraction) { return refine_sides(gray, q, reach_fraction); }
+void make_clockwise(Quad& q) { track::make_clockwise(q); }
+bool in_image(const Quad& q, const cv::Mat& gray, const PadOptions& options) { return track::in_image(q, gray, options); }
+std::optional<PadObservation> rectangle_pose(const Quad& q, double hx, double hy, const camera::CameraModel& camera,
+                                             const PadOptions& options) {
+  return track::rectangle_pose(q, hx, hy, camera, options);
+}
+cv::Mat top_view(const cv::Mat& gray, const Quad& q, int side) { return track::top_view(gray, q, side); }
+double correlation(const cv::Mat& a, const cv::Mat& b) { return track::correlation(a, b); }
+cv::Rect window_in(const cv::Rect2d& search, const cv::Mat& gray) { return track::window_in(search, gray); }
+void check_frame(const char* who, const cv::Mat& gray, const camera::CameraModel& camera) { check(who, gray, camera, nullptr); }
+
+}  // namespace detail
 
 std::optional<PadObservation> observe_pad(const cv::Mat& frame, const cv::Rect2d& search, const camera::CameraModel& camera,
                                           const PadGeometry& pad, const PadOptions& opt, PadMiss* miss) {
