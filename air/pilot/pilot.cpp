@@ -50,6 +50,10 @@ void PilotConfig::validate() const {
   need(stale_timeout_s > 0 && control_period_s > 0 && abort_climb_s >= 0 && hold_climb_max_s >= 0,
        "stale_timeout_s and control_period_s must be > 0");
   for (const auto& leg : survey_legs) need(leg.allFinite(), "survey legs must be finite");
+  feedforward.estimator.validate();
+  need(feedforward.min_speed_m_s >= 0 && feedforward.max_speed_m_s > 0 && feedforward.touchdown_speed_m_s > 0 &&
+           feedforward.touchdown_margin_s >= 0,
+       "feedforward: min_speed_m_s >= 0, max_speed_m_s > 0, touchdown_speed_m_s > 0, touchdown_margin_s >= 0");
   const std::pair<const char*, const AxisGains*> axes[] = {{"forward", &forward}, {"left", &left}, {"up", &up}, {"yaw", &yaw}};
   for (const auto& [axis, g] : axes)
     if (!g->valid())
@@ -57,7 +61,7 @@ void PilotConfig::validate() const {
                                   ": finite; kp, ki, kd >= 0; ku, integral_limit, output_limit > 0");
 }
 
-Pilot::Pilot(PilotConfig config) : cfg_(std::move(config)) {
+Pilot::Pilot(PilotConfig config) : cfg_(std::move(config)), pad_velocity_(cfg_.feedforward.estimator) {
   cfg_.validate();
   forward_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.forward);
   left_ = make_axis(cfg_.controller, cfg_.fuzzy_base, cfg_.left);
@@ -81,6 +85,11 @@ void Pilot::on_target(const TargetObservation& t) {
 
 void Pilot::enter(State s, int64_t utime, const std::string& reason) {
   if (s == State::Approach && status_.state != State::Hold) reset_controllers();
+  if (s == State::Hold) hold_ff_level_ = estimated_feedforward();  // follow the pad's last motion
+  if (s == State::Touchdown) {  // the handover onto a moving pad sets them
+    touchdown_ff_level_.setZero();
+    blind_s_ = 0;
+  }
   status_.state = s;
   status_.reason = reason;
   state_since_ = utime;
@@ -104,8 +113,20 @@ Command Pilot::hover(int64_t utime) const {
 Command Pilot::steer(int64_t utime, double t, const Eigen::Vector3d& target, double yaw_error_deg, double vz) {
   Command c = hover(utime);
   c.velocity = {forward_->update(t, target.x()), left_->update(t, target.y()), vz};
+  if (ff_on_) c.velocity.head<2>() += ff_;  // only when on: -0.0 + 0.0 would change a still pad's bytes
   c.yaw_rate_deg_s = yaw_->update(t, yaw_error_deg);
   return c;
+}
+
+Eigen::Vector2d Pilot::to_heading(const Eigen::Vector2d& level) const {
+  return Eigen::Rotation2Dd(-ahrs_yaw_) * level;
+}
+
+Eigen::Vector2d Pilot::estimated_feedforward() const {
+  const auto& f = cfg_.feedforward;
+  const Eigen::Vector2d v = pad_velocity_.velocity();
+  if (!f.enabled || v.norm() < f.min_speed_m_s) return Eigen::Vector2d::Zero();
+  return v.norm() > f.max_speed_m_s ? Eigen::Vector2d(v.normalized() * f.max_speed_m_s) : v;
 }
 
 void Pilot::on_autopilot_link(bool ok, int64_t utime) {
@@ -188,6 +209,16 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
     const Eigen::Matrix3d tilt = Eigen::AngleAxisd(-std::atan2(R(1, 0), R(0, 0)), Eigen::Vector3d::UnitZ()) * R;
     p = tilt * (R_body_cam_ * target_->position_cam);
     height = -p.z();
+  }
+  if (cfg_.feedforward.enabled) {
+    const Eigen::Matrix3d R = attitude_.toRotationMatrix();
+    ahrs_yaw_ = std::atan2(R(1, 0), R(0, 0));
+    if (have) pad_velocity_.observe(t, Eigen::Rotation2Dd(ahrs_yaw_) * p.head<2>());
+    ff_ = to_heading(estimated_feedforward());
+    ff_on_ = !ff_.isZero();
+    status_.pad_velocity = pad_velocity_.velocity();
+  }
+  if (have) {
     // Body forward is image "up" (-y) for a camera pitched down: the pad's axis should sit
     // at -90 deg in the image; the rest is the turn still needed (clockwise positive).
     yaw_err = wrap_half_turn_deg(target_->yaw_cam / kDeg + 90.0);
@@ -265,9 +296,10 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
       }
       if (!target_->fitted) {
         // A box-only pose is too coarse this low: a box cut by the image border, chased,
-        // leads the vehicle off the pad. Hover, and climb slowly (a wider view) until the
-        // pad's geometry is fitted again.
+        // leads the vehicle off the pad. Hover (moving with a moving pad), and climb slowly
+        // (a wider view) until the pad's geometry is fitted again.
         settled_run_ = 0;
+        if (ff_on_) c.velocity.head<2>() = ff_;
         if (height < cfg_.approach_height_m) c.velocity.z() = cfg_.hold_climb_m_s;
         break;
       }
@@ -279,6 +311,12 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
         if (settled_run_ >= cfg_.handover_frames) {
           enter(State::Touchdown, utime, "centred below the touchdown height");
           c.mode = Command::Mode::Land;
+          if (ff_on_) {  // a moving pad: descend with it (LAND would stop over the ground)
+            touchdown_ff_level_ = estimated_feedforward();
+            blind_s_ = height / cfg_.feedforward.touchdown_speed_m_s + cfg_.feedforward.touchdown_margin_s;
+            c.mode = Command::Mode::Velocity;
+            c.velocity = {ff_.x(), ff_.y(), -cfg_.feedforward.touchdown_speed_m_s};
+          }
         } else {
           c = steer(utime, t, p, yaw_err, 0.0);
         }
@@ -293,7 +331,12 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
     }
     case State::Touchdown:
       c.mode = Command::Mode::Land;
-      if (time_in_state() >= cfg_.touchdown_time_s) enter(State::Landed, utime, "touchdown");
+      if (time_in_state() < blind_s_) {  // onto a moving pad: with it, blind, then LAND
+        const Eigen::Vector2d v = to_heading(touchdown_ff_level_);
+        c.mode = Command::Mode::Velocity;
+        c.velocity = {v.x(), v.y(), -cfg_.feedforward.touchdown_speed_m_s};
+      }
+      if (time_in_state() >= cfg_.touchdown_time_s + blind_s_) enter(State::Landed, utime, "touchdown");
       break;
     case State::Landed:
       c.mode = Command::Mode::Land;
@@ -309,6 +352,7 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
         break;
       }
       if (time_in_state() < cfg_.hold_climb_max_s) c.velocity.z() = cfg_.hold_climb_m_s;
+      if (!hold_ff_level_.isZero()) c.velocity.head<2>() = to_heading(hold_ff_level_);  // with the pad's last motion
       break;
     case State::Abort:
       c.velocity.z() = cfg_.abort_climb_m_s;
@@ -318,6 +362,12 @@ Command Pilot::tick(int64_t utime, bool fresh_track, TrackStatus track) {
       break;
   }
   status_.time_in_state_s = time_in_state();
+  if (cfg_.feedforward.enabled) {
+    // What the vehicle is asked to fly from now on (HOVER, TAKEOFF and LAND hold still).
+    const bool flies = c.mode == Command::Mode::Velocity;
+    pad_velocity_.command(t, flies ? Eigen::Vector2d(Eigen::Rotation2Dd(ahrs_yaw_) * c.velocity.head<2>()) : Eigen::Vector2d::Zero());
+    status_.feedforward = flies ? ff_ : Eigen::Vector2d::Zero();
+  }
   return last_ = c;
 }
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "air/pilot/landing_control.hpp"
+#include "air/pilot/pad_velocity.hpp"
 #include "common/flc/flc.hpp"
 #include "common/util/message_clock.hpp"
 
@@ -71,6 +72,19 @@ struct PilotConfig {
   // a message whose utime jumps by more than 1 s is held, so one bogus stamp never moves the
   // state machine's clock (docs/architecture.md "Message time").
   util::MessageClockConfig message_time{1'000'000, 3, 2'000'000};
+  // Velocity feed-forward for a moving pad (pad_velocity.hpp): the pad's estimated velocity
+  // is added to the horizontal command in APPROACH, DESCEND and HOLD, and TOUCHDOWN descends
+  // with it (blind, at touchdown_speed_m_s) instead of the autopilot's LAND, which would
+  // hold the ground point where it began; LAND follows once the feet must be down. A pad
+  // slower than min_speed_m_s gets none: a still pad flies exactly as without it.
+  struct FeedForward {
+    bool enabled = false;
+    PadVelocityConfig estimator;
+    double min_speed_m_s = 0.3;      // below this estimated speed: no feed-forward
+    double max_speed_m_s = 3.0;      // the feed-forward is clamped to this
+    double touchdown_speed_m_s = 0.5;  // the blind descent onto a moving pad ...
+    double touchdown_margin_s = 1.0;   // ... lasts height / speed + this, then LAND
+  } feedforward;
   void validate() const;             // throws std::invalid_argument naming the field
 };
 
@@ -105,6 +119,10 @@ struct PilotStatus {
   int age_holds = 0;    // HOLDs entered because its results were older than max_input_age_s
   int aged_results = 0; // tracker results not flown on because of their age
   int link_holds = 0;   // HOLDs entered because the autopilot's link was lost
+  // The pad's estimated velocity (AHRS level frame, m/s; zero until valid) and the
+  // feed-forward added to the last command (heading frame; zero when none).
+  Eigen::Vector2d pad_velocity = Eigen::Vector2d::Zero();
+  Eigen::Vector2d feedforward = Eigen::Vector2d::Zero();
 };
 
 class Pilot {
@@ -142,6 +160,8 @@ class Pilot {
   Command hover(int64_t utime) const;
   Command steer(int64_t utime, double t, const Eigen::Vector3d& target, double yaw_error_deg, double vz) ;
   void reset_controllers();
+  Eigen::Vector2d to_heading(const Eigen::Vector2d& level) const;  // by the AHRS yaw
+  Eigen::Vector2d estimated_feedforward() const;                    // level frame; zero below min_speed_m_s
 
   PilotConfig cfg_;
   std::unique_ptr<AxisController> forward_, left_, up_, yaw_;
@@ -155,6 +175,12 @@ class Pilot {
   bool started_ = false;
   bool autopilot_link_ok_ = true;
   Command last_;
+  PadVelocityEstimator pad_velocity_;
+  double ahrs_yaw_ = 0;            // the AHRS yaw of this tick (rad)
+  Eigen::Vector2d ff_ = Eigen::Vector2d::Zero();  // this tick's feed-forward, heading frame
+  bool ff_on_ = false;
+  Eigen::Vector2d hold_ff_level_ = Eigen::Vector2d::Zero(), touchdown_ff_level_ = Eigen::Vector2d::Zero();
+  double blind_s_ = 0;             // TOUCHDOWN onto a moving pad: the blind descent's duration
 };
 
 }  // namespace aerie::pilot

@@ -35,6 +35,7 @@ PilotConfig load_pilot_config(const util::Config& cfg) {
       .known("abort")
       .known("gains")
       .known("message_time")
+      .known("feedforward")
       .finish();
   p.message_time = util::MessageClockConfig::from_config(cfg.section("message_time"), p.message_time);
   const std::string rules = cfg.get<std::string>("fuzzy_rules", "");
@@ -61,6 +62,19 @@ PilotConfig load_pilot_config(const util::Config& cfg) {
       "max_input_age_s", &P::max_input_age_s)("loss_frames", &P::loss_frames)("timeout_s", &P::hold_timeout_s)(
       "climb_m_s", &P::hold_climb_m_s)("climb_max_s", &P::hold_climb_max_s)
       .finish();
+  using F = PilotConfig::FeedForward;
+  const util::Config ff = cfg.section("feedforward");
+  util::SectionReader<F>(ff, p.feedforward)("enabled", &F::enabled)("min_speed_m_s", &F::min_speed_m_s)(
+      "max_speed_m_s", &F::max_speed_m_s)("touchdown_speed_m_s", &F::touchdown_speed_m_s)(
+      "touchdown_margin_s", &F::touchdown_margin_s)
+      .known("alpha")
+      .known("vehicle_time_constant_s")
+      .known("max_gap_s")
+      .known("min_updates")
+      .finish();
+  using E = PadVelocityConfig;
+  util::SectionReader<E>(ff, p.feedforward.estimator)("alpha", &E::alpha)(
+      "vehicle_time_constant_s", &E::vehicle_time_constant_s)("max_gap_s", &E::max_gap_s)("min_updates", &E::min_updates);
   util::SectionReader<P>(cfg.section("abort"), p)("climb_m_s", &P::abort_climb_m_s)("climb_s", &P::abort_climb_s)
       .finish();
 

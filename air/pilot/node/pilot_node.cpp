@@ -34,11 +34,12 @@ PilotNode::PilotNode(bus::Bus& bus, PilotConfig config, PilotNodeOptions options
   };
   bus_.subscribe<aerie::target_pose_t>(opt_.target_channel, [this, guarded](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
     guarded(opt_.target_channel, [&] {
-      if (m.source != aerie::target_pose_t::SOURCE_BOX && m.source != aerie::target_pose_t::SOURCE_FIT)
+      if (m.source < aerie::target_pose_t::SOURCE_BOX || m.source > aerie::target_pose_t::SOURCE_ARUCO)
         throw std::invalid_argument("unknown target pose source " + std::to_string(m.source));
       if (!on_time(track_time_, opt_.target_channel, m.utime)) return;
+      // Every source but the box fits the target's own geometry (a pad's corners, a fiducial's).
       pilot_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.yaw,
-                        m.source == aerie::target_pose_t::SOURCE_FIT});
+                        m.source != aerie::target_pose_t::SOURCE_BOX});
       count("targets");
     });
   });

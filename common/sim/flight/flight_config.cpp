@@ -62,6 +62,7 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
       .known("wind")
       .known("vibration")
       .known("placement")
+      .known("platform")
       .known("camera_effects")("stereo", &F::stereo)("frame_rate_hz", &F::frame_rate_hz)("max_time_s", &F::max_time_s)(
           "seed", &F::seed)("start_utime", &F::start_utime)
       .finish();
@@ -81,7 +82,12 @@ FlightSimConfig load_flight_config(const util::Config& cfg) {
   using W = WindParams;
   util::SectionReader<W>(cfg.section("wind"), f.wind)("mean_m_s", &W::mean_m_s)("gust_std_m_s", &W::gust_std_m_s)(
       "gust_time_constant_s", &W::gust_time_constant_s)("yaw_gust_std_per_speed", &W::yaw_gust_std_per_speed)(
-      "yaw_gust_time_constant_s", &W::yaw_gust_time_constant_s)
+      "yaw_gust_time_constant_s", &W::yaw_gust_time_constant_s)("model", &W::model)("w20_m_s", &W::w20_m_s)
+      .finish();
+  using T = PlatformParams;
+  util::SectionReader<T>(cfg.section("platform"), f.platform)("motion", &T::motion)("speed_m_s", &T::speed_m_s)(
+      "heading_deg", &T::heading_deg)("start_time_s", &T::start_time_s)("turn_rate_deg_s", &T::turn_rate_deg_s)(
+      "brake_time_s", &T::brake_time_s)("deceleration_m_s2", &T::deceleration_m_s2)
       .finish();
   using V = VibrationParams;
   util::SectionReader<V>(cfg.section("vibration"), f.vibration)("enabled", &V::enabled)(

@@ -87,6 +87,12 @@ void FlightSimConfig::validate() const {
   need(std::abs(ratio - std::round(ratio)) < 1e-9, "imu.rate_hz must be a whole multiple of frame_rate_hz");
   need(wind.mean_m_s >= 0 && wind.mean_m_s <= 15, "wind.mean_m_s must be in [0, 15]");
   need(wind.gust_time_constant_s > 0, "wind.gust_time_constant_s must be > 0");
+  need(wind.model == "gauss_markov" || wind.model == "dryden",
+       "wind.model must be gauss_markov or dryden (got '" + wind.model + "')");
+  need(wind.w20_m_s <= 15, "wind.w20_m_s must be <= 15 (< 0: mean_m_s)");
+  platform.validate();
+  need(!platform.moving() || world.kind == "field",
+       "platform: a moving platform needs world.kind field (the room's helipad is the floor)");
   need(wind.yaw_gust_std_per_speed >= 0 && wind.yaw_gust_std_per_speed <= 50,
        "wind.yaw_gust_std_per_speed must be in [0, 50] (deg/s per m/s)");
   need(wind.yaw_gust_time_constant_s > 0, "wind.yaw_gust_time_constant_s must be > 0");
@@ -254,6 +260,54 @@ FlightSim::FlightSim(const FlightSimConfig& config)
   gust_ = cfg_.wind.gust_std() * Eigen::Vector3d(gust_x, gust_y, 0.0);
   for (auto& axis : vib_phase_) axis = {2 * kPi * u01(rng_), 2 * kPi * u01(rng_), 0.85, 1.15};
   yaw_gust_rng_.seed(mix_seed(cfg_.seed, 7007));
+  // Dryden turbulence and the platform's heading on streams of their own: every draw above
+  // is the same whatever they are.
+  wind_theta_ = theta;
+  if (cfg_.wind.model == "dryden") {
+    dryden_ = DrydenGusts(mix_seed(cfg_.seed, 7011));
+    dryden_.start(dryden_scales(), (wind_mean_ - vehicle_.state().velocity).norm());
+    gust_ = dryden_world(dryden_.value());
+  }
+  base_world_ = world_;
+  if (cfg_.platform.moving()) {
+    double heading = cfg_.platform.heading_deg * kDeg;
+    if (std::isnan(heading)) {  // along the car's length, either way
+      std::mt19937_64 g(mix_seed(cfg_.seed, 7012));
+      const Eigen::Vector3d size = world_.landing_object()->box.size();
+      heading = (size.x() >= size.y() ? 0.0 : kPi / 2) + (u01(g) < 0.5 ? 0.0 : kPi);
+    }
+    platform_ = PlatformMotion(cfg_.platform, heading);
+  }
+}
+
+DrydenScales FlightSim::dryden_scales() const {
+  const double w20 = cfg_.wind.w20_m_s < 0 ? cfg_.wind.mean_m_s : cfg_.wind.w20_m_s;
+  return dryden_low_altitude(vehicle_.state().position.z() - world_.bounds().min.z(), w20);
+}
+
+// Dryden's (u, v, w): along the mean wind, across it (to its left), up.
+Eigen::Vector3d FlightSim::dryden_world(const Eigen::Vector3d& uvw) const {
+  const double c = std::cos(wind_theta_), s = std::sin(wind_theta_);
+  return {c * uvw.x() - s * uvw.y(), s * uvw.x() + c * uvw.y(), uvw.z()};
+}
+
+Eigen::Vector2d FlightSim::platform_velocity() const {
+  return platform_stopped_ ? Eigen::Vector2d::Zero() : platform_.velocity(t_);
+}
+
+void FlightSim::move_platform(double t) {
+  if (!cfg_.platform.moving() || platform_stopped_) return;
+  const Eigen::Vector2d d = platform_.offset(t);
+  // The car stops at the field's edge (0.5 m inside it).
+  const Aabb& b = base_world_.landing_object()->box;
+  const Aabb& field = base_world_.bounds();
+  if (b.min.x() + d.x() < field.min.x() + 0.5 || b.max.x() + d.x() > field.max.x() - 0.5 ||
+      b.min.y() + d.y() < field.min.y() + 0.5 || b.max.y() + d.y() > field.max.y() - 0.5) {
+    platform_stopped_ = true;
+    return;
+  }
+  platform_offset_ = d;
+  world_ = base_world_.with_landing_offset(d);
 }
 
 void FlightSim::set_start_utime(int64_t utime) {
@@ -275,6 +329,12 @@ double FlightSim::support_height(const Eigen::Vector3d& p) const {
 }
 
 Eigen::Vector3d FlightSim::wind_step(double dt) {
+  if (cfg_.wind.model == "dryden") {
+    // The airspeed the turbulence is advected past the vehicle with (Taylor's hypothesis).
+    const double airspeed = (wind_mean_ - vehicle_.state().velocity).norm();
+    gust_ = dryden_world(dryden_.step(dt, dryden_scales(), airspeed));
+    return wind_mean_ + gust_;
+  }
   // First-order Gauss-Markov gusts per horizontal axis, exact discretisation.
   const double a = std::exp(-dt / cfg_.wind.gust_time_constant_s), k = std::sqrt(1 - a * a) * cfg_.wind.gust_std();
   std::normal_distribution<double> n01(0.0, 1.0);
@@ -339,6 +399,18 @@ std::string FlightSim::command(const CommandInput& c) {
 }
 
 void FlightSim::physics_step(double dt) {
+  // A disarmed vehicle standing on the car's roof rides with it.
+  const Eigen::Vector2d platform_before = platform_offset_;
+  const Obstacle* car = world_.landing_object();
+  const Eigen::Vector3d& p = vehicle_.state().position;
+  const bool on_car = car && !vehicle_.state().armed && vehicle_.state().on_ground &&
+                      std::abs(p.z() - car->box.max.z()) < 1e-6 && p.x() >= car->box.min.x() &&
+                      p.x() <= car->box.max.x() && p.y() >= car->box.min.y() && p.y() <= car->box.max.y();
+  move_platform(t_ + dt);
+  if (on_car && platform_offset_ != platform_before) {  // the roof carries what stands on it
+    const Eigen::Vector2d d = platform_offset_ - platform_before;
+    vehicle_.carry({d.x(), d.y(), 0.0});
+  }
   if (outcome_.collided || outcome_.landed) return;
   const Eigen::Vector3d wind = wind_step(dt);
   const double vz_before = vehicle_.state().velocity.z();
@@ -357,6 +429,8 @@ void FlightSim::physics_step(double dt) {
         outcome_.touchdown_position = {s.position.x(), s.position.y(), z_support};
         outcome_.touchdown_yaw = s.yaw;
         outcome_.touchdown_vertical_speed = -vz;
+        outcome_.touchdown_pad_center = world_.helipad().center;
+        outcome_.touchdown_pad_velocity = platform_stopped_ ? Eigen::Vector2d::Zero() : platform_.velocity(t_ + dt);
       }
     }
     vehicle_.set_contact(z_support);
@@ -408,6 +482,11 @@ FlightFrame FlightSim::step() {
   f.utime = utime_of(t_);
   f.vehicle = vehicle_.state();
   f.wind = wind_mean_ + gust_;
+  f.platform_velocity = platform_velocity();
+  if (cfg_.platform.moving()) {  // the renderers draw the world as it is now
+    down_ = StereoRenderer(world_, down_.rig());
+    if (cfg_.stereo) forward_ = StereoRenderer(world_, forward_.rig());
+  }
   const geometry::SE3 T_world_body = f.vehicle.pose();
   f.T_world_down = T_world_body * T_body_down_ * vibration(t_);
   f.down = down_.render_mono(f.T_world_down, f.utime, f.seq);
@@ -454,7 +533,7 @@ LandingScore score_landing(const FlightSim& sim, double max_error_m, double max_
   LandingScore s;
   if (o.touchdown_time_s < 0) return s;
   const Helipad& pad = sim.world().helipad();
-  s.touchdown_error_m = (o.touchdown_position - pad.center).head<2>().norm();
+  s.touchdown_error_m = (o.touchdown_position - o.touchdown_pad_center).head<2>().norm();  // on the pad as it was then
   s.yaw_error_deg = wrap_half_turn(o.touchdown_yaw - pad.yaw) / kDeg;
   s.time_s = o.touchdown_time_s;
   s.success = o.landed && !o.collided && !o.timed_out && s.touchdown_error_m <= max_error_m &&

@@ -20,8 +20,10 @@
 
 #include "common/geometry/se3.hpp"
 #include "common/sim/camera/camera_effects.hpp"
+#include "common/sim/flight/dryden.hpp"
 #include "common/sim/flight/imu.hpp"
 #include "common/sim/flight/multirotor.hpp"
+#include "common/sim/flight/platform.hpp"
 #include "common/sim/stereo_renderer.hpp"
 #include "common/sim/world.hpp"
 
@@ -29,8 +31,12 @@ namespace aerie::sim {
 
 struct WindParams {
   double mean_m_s = 0.0;             // steady wind speed (direction drawn from the seed)
-  double gust_std_m_s = -1.0;        // gust standard deviation per horizontal axis; < 0: 0.3 * mean
-  double gust_time_constant_s = 2.0; // first-order Gauss-Markov gusts (Dryden-like)
+  // gauss_markov: the historical gusts (below; every earlier figure reproduces with it);
+  // dryden: MIL-F-8785C / MIL-HDBK-1797 low-altitude Dryden turbulence (dryden.hpp), u, v, w.
+  std::string model = "gauss_markov";
+  double gust_std_m_s = -1.0;        // gauss_markov: gust standard deviation per horizontal axis; < 0: 0.3 * mean
+  double gust_time_constant_s = 2.0; // gauss_markov: first-order Gauss-Markov time constant
+  double w20_m_s = -1.0;             // dryden: wind speed at 20 ft (sigma_w = 0.1 W20); < 0: mean_m_s
   // Yaw-rate gusts in forward flight (thesis 5.1.5, as aerie-ceopt's scenario): first-order
   // Gauss-Markov, standard deviation growing with the horizontal speed; 0 = none.
   double yaw_gust_std_per_speed = 0.0;    // (deg/s) per (m/s)
@@ -79,6 +85,7 @@ struct FlightSimConfig {
   WindParams wind;
   VibrationParams vibration;
   PlacementParams placement;
+  PlatformParams platform;         // the field's car driving (default still: today's world)
   double max_time_s = 120.0;       // the flight ends (timed out) after this
   uint64_t seed = 1;
   int64_t start_utime = 0;         // utime of frame 0
@@ -106,6 +113,8 @@ struct FlightOutcome {
   Eigen::Vector3d touchdown_position = Eigen::Vector3d::Zero();
   double touchdown_yaw = 0;        // rad, ENU
   double touchdown_vertical_speed = 0;  // m/s, positive down
+  Eigen::Vector3d touchdown_pad_center = Eigen::Vector3d::Zero();  // the pad's centre at the touchdown (it may move)
+  Eigen::Vector2d touchdown_pad_velocity = Eigen::Vector2d::Zero(); // the platform's velocity then, m/s
   bool ended() const { return landed || collided || timed_out; }
 };
 
@@ -137,6 +146,7 @@ struct FlightFrame {
   geometry::SE3 T_world_left;      // forward left camera (with vibration; rendered when stereo)
   MultirotorState vehicle;
   Eigen::Vector3d wind = Eigen::Vector3d::Zero();
+  Eigen::Vector2d platform_velocity = Eigen::Vector2d::Zero();  // of the landing object, world, m/s
   TargetTruth target;              // in the down camera
 };
 
@@ -155,7 +165,11 @@ class FlightSim {
   double time() const { return t_; }
   int64_t frame() const { return frame_; }
   int64_t utime_of(double t) const;
+  // The world now (with the moving platform where it is at time()).
   const World& world() const { return world_; }
+  // The landing object's displacement from its place at t = 0 and its velocity, now (m, m/s).
+  const Eigen::Vector2d& platform_offset() const { return platform_offset_; }
+  Eigen::Vector2d platform_velocity() const;
   const Multirotor& vehicle() const { return vehicle_; }
   const FlightOutcome& outcome() const { return outcome_; }
   const FlightSimConfig& config() const { return cfg_; }
@@ -180,6 +194,9 @@ class FlightSim {
   double yaw_gust_step(double dt);
   geometry::SE3 vibration(double t) const;
   double support_height(const Eigen::Vector3d& p) const;
+  void move_platform(double t);
+  DrydenScales dryden_scales() const;
+  Eigen::Vector3d dryden_world(const Eigen::Vector3d& uvw) const;
 
   FlightSimConfig cfg_;
   World world_;
@@ -190,6 +207,12 @@ class FlightSim {
   std::mt19937_64 rng_;
   geometry::SE3 T_body_down_, T_body_left_;
   Eigen::Vector3d wind_mean_ = Eigen::Vector3d::Zero(), gust_ = Eigen::Vector3d::Zero();
+  DrydenGusts dryden_{0};          // its own stream (wind.model dryden)
+  PlatformMotion platform_;
+  World base_world_;               // the world at t = 0 (the platform where it was built)
+  Eigen::Vector2d platform_offset_ = Eigen::Vector2d::Zero();
+  bool platform_stopped_ = false;  // at the field's edge
+  double wind_theta_ = 0;          // direction of the mean wind (the Dryden u axis)
   std::mt19937_64 yaw_gust_rng_;   // its own stream: enabling yaw gusts leaves every other draw as it was
   double yaw_gust_deg_s_ = 0.0;
   std::array<std::array<double, 4>, 3> vib_phase_{};  // per axis: two phases, two frequency factors

@@ -94,6 +94,8 @@ class Multirotor {
   // The vehicle rests on a surface at height z_surface: vertical motion stops, and
   // horizontal motion and tilt too when disarmed.
   void set_contact(double z_surface);
+  // Moves the vehicle with the surface it rests on (the moving platform carrying it).
+  void carry(const Eigen::Vector3d& displacement) { s_.position += displacement; }
   // The highest world z the autopilot lets its feet climb to (the height fence); +inf = none.
   void set_ceiling(double z) { ceiling_z_ = z; }
   double ceiling() const { return ceiling_z_; }
