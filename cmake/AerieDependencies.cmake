@@ -9,7 +9,13 @@ find_package(Threads REQUIRED)
 find_package(Eigen3 3.4 REQUIRED NO_MODULE)
 # Link OpenCV by component, never ${OpenCV_LIBS} (it drags opencv_viz -> VTK, see NOTES.md).
 find_package(OpenCV 4.6 REQUIRED COMPONENTS core imgproc imgcodecs videoio calib3d features2d
-             video tracking)
+             video tracking aruco)                             # aruco: libopencv-contrib-dev (track/fiducial)
+# AprilTag 3 (libapriltag-dev): the fiducial pose source of the landing (air/track/fiducial).
+find_package(apriltag 3 QUIET CONFIG)
+if(NOT TARGET apriltag::apriltag)
+  message(FATAL_ERROR "AprilTag 3 not found (apriltagConfig.cmake, target apriltag::apriltag): "
+                      "install the Debian package libapriltag-dev (scripts/setup.sh)")
+endif()
 find_package(Ceres 2.1 REQUIRED)
 if(NOT AERIE_AIR_ONLY)                                          # the ground side's (map, ceopt)
   find_package(octomap REQUIRED)

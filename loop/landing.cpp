@@ -149,7 +149,7 @@ RunResult fly(const RunConfig& config) {
     r.descent.push_back({m.utime * 1e-6, g.position.z(), m.position[0] - g.position.x(), m.position[1] - g.position.y(),
                          m.position[2] - g.position.z(),
                          std::remainder(m.yaw - g.yaw, std::numbers::pi) * 180 / std::numbers::pi,
-                         m.source == aerie::target_pose_t::SOURCE_FIT});
+                         m.source != aerie::target_pose_t::SOURCE_BOX});
   }, 1000);
 
   int64_t end_frame = -1;

@@ -52,7 +52,7 @@ struct MavlinkCounters {
 };
 
 // TARGET_POSE against the truth of its frame, during the pilot's DESCEND; fitted: the pad's
-// corners fitted (SOURCE_FIT, what the pilot descends on), else the tracker's box only.
+// corners fitted (SOURCE_FIT, or a fiducial board: what the pilot descends on), else the tracker's box only.
 struct DescentSample {
   double t = 0, height = 0, ex = 0, ey = 0, ez = 0, eyaw_deg = 0;
   bool fitted = true;

@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   liblcm-dev liblcm-bin liblcm-java default-jdk-headless libjchart2d-java libglib2.0-dev
-  libopencv-dev libopencv-contrib-dev libeigen3-dev libceres-dev
+  libopencv-dev libopencv-contrib-dev libeigen3-dev libceres-dev libapriltag-dev
   liboctomap-dev libdynamicedt3d-dev octomap-tools
   libvtk9-dev mpi-default-dev xvfb xauth
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfuzzylite-dev libnlopt-cxx-dev libhwy-dev libsodium-dev

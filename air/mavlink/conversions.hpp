@@ -68,7 +68,7 @@ class OdometryStream {
 struct CameraTarget {
   int64_t utime = 0;
   Eigen::Vector3d position_cam = Eigen::Vector3d::Zero();  // optical frame, m (z > 0)
-  bool fitted = true;  // fitted to the target's geometry (target_pose_t SOURCE_FIT), not the box alone
+  bool fitted = true;  // fitted to the target's geometry (pad or fiducials: any source but SOURCE_BOX), not the box alone
 };
 
 // The vehicle in the autopilot's local frame, from its LOCAL_POSITION_NED and ATTITUDE_QUATERNION.

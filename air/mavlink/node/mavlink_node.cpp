@@ -74,7 +74,7 @@ MavlinkNode::MavlinkNode(bus::Bus& bus, AutopilotLink link, std::unique_ptr<mavl
   });
   subscribe<aerie::target_pose_t>(opt_.target_channel, [this](const aerie::target_pose_t& m, const bus::ReceiveInfo&) {
     const int64_t t = now_();
-    link_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.source == aerie::target_pose_t::SOURCE_FIT},
+    link_.on_target({m.utime, {m.position[0], m.position[1], m.position[2]}, m.source != aerie::target_pose_t::SOURCE_BOX},
                     t);
     flush(t);
   });

@@ -21,7 +21,7 @@ NodeOptions node_options(const util::Config& cfg) {
                   "node.init_from_gt", "target.name", "target.width_m", "target.height_m", "target.yaw_offset_deg",
                   "target.shape", "target.border", "target.search_margin", "target.reseed_iou", "target.fit_h_when_cut",
                   "camera.calibration", "camera.fx", "camera.fy", "camera.cx", "camera.cy", "camera.width", "camera.height", "trackers.*",
-                  "message_time.*", "node.max_queued_commands", "node.max_queued_bytes"});
+                  "message_time.*", "node.max_queued_commands", "node.max_queued_bytes", "target.pose_source", "fiducial.*"});
   NodeOptions o;
   const util::Config node = cfg.section("node");
   o.camera_channel = node.get("camera_channel", o.camera_channel);
@@ -54,6 +54,14 @@ NodeOptions node_options(const util::Config& cfg) {
   o.reseed_iou = target.get_in("reseed_iou", o.reseed_iou, 0.0, 1.0);
   o.fit_h_when_cut = target.get("fit_h_when_cut", o.fit_h_when_cut);
   if (!(o.pad_border >= 0 && o.pad_border < 0.25)) throw std::runtime_error(cfg.origin() + ": target.border must be in [0, 0.25)");
+  // The pose source (docs/track.md, "Fiducials"): the tracker (target.shape), or a fiducial board.
+  const std::string source = target.get<std::string>("pose_source", "tracker");
+  if (source == "apriltag" || source == "aruco") {
+    o.fiducial = fiducial_board(cfg.section("fiducial"), fiducial_kind_from_string(source));
+    o.fiducial_options = fiducial_options(cfg.section("fiducial"));
+  } else if (source != "tracker") {
+    throw std::runtime_error(cfg.origin() + ": target.pose_source must be tracker, apriltag or aruco, got '" + source + "'");
+  }
 
   const util::Config cam = cfg.section("camera");
   if (cam.has("calibration")) {
@@ -165,6 +173,7 @@ TrackNode::TrackNode(bus::Bus& bus, NodeOptions options, util::NodeClock now)
     if (!(opt_.search_margin >= 0)) throw std::invalid_argument("target.search_margin must be >= 0");
     if (!(opt_.reseed_iou >= 0 && opt_.reseed_iou <= 1)) throw std::invalid_argument("target.reseed_iou must be in [0, 1]");
   }
+  if (opt_.fiducial) fiducial_ = std::make_unique<FiducialDetector>(*opt_.fiducial, opt_.fiducial_options);
   tracker_params_ = opt_.trackers.section(opt_.tracker);
   const int camera_queue = opt_.every_frame ? 1000 : 30;
   if (opt_.stereo) {
@@ -550,6 +559,7 @@ void TrackNode::execute(const aerie::track_cmd_t& cmd) {
 }
 
 void TrackNode::process(const Frame& frame) {
+  if (fiducial_) return process_fiducial(frame);
   if (!tracker_) {
     publish(frame, nullptr, 0);
     return;
@@ -572,6 +582,41 @@ void TrackNode::process(const Frame& frame) {
     tracker_name_.clear();
     publish(frame, nullptr, sw.ms());
   }
+}
+
+// The fiducial board in the whole frame: TRACK from the box of its tags (TRACKING when seen;
+// LOST once seen, IDLE before), TARGET_POSE from its pose (source APRILTAG / ARUCO).
+void TrackNode::process_fiducial(const Frame& frame) {
+  const util::Stopwatch sw;
+  std::optional<FiducialPose> pose;
+  FiducialMiss miss = FiducialMiss::None;
+  try {
+    if (!last_camera_) throw std::invalid_argument("no camera intrinsics (camera section or image metadata)");
+    pose = fiducial_->estimate(last_frame_, *last_camera_, &miss);
+  } catch (const std::exception& e) {
+    count("fiducial_errors");
+    fail(opt_.pose_channel + ": " + e.what());
+  }
+  const double ms = sw.ms();
+  count("frames_processed");
+  aerie::track_t m = track_message(frame, to_string(opt_.fiducial->kind), ms);
+  m.status = pose ? aerie::track_t::TRACKING : fiducial_seen_ ? aerie::track_t::LOST : aerie::track_t::IDLE;
+  if (pose) {
+    fiducial_seen_ = true;
+    count("fiducial_found");
+    const cv::Rect2d& b = pose->box;
+    m.x = b.x + b.width / 2, m.y = b.y + b.height / 2, m.scale = 1;
+    m.width = b.width, m.height = b.height;
+    const cv::Point2d c[4] = {b.tl(), {b.x + b.width, b.y}, b.br(), {b.x, b.y + b.height}};
+    for (int i = 0; i < 4; ++i) m.corners[i][0] = c[i].x, m.corners[i][1] = c[i].y;
+    m.confidence = static_cast<float>(pose->quality);
+    publish_pose(m, {pose->position, pose->yaw},  // goes first: TRACK closes the frame
+                 opt_.fiducial->kind == FiducialKind::AprilTag ? aerie::target_pose_t::SOURCE_APRILTAG
+                                                               : aerie::target_pose_t::SOURCE_ARUCO);
+  } else if (miss != FiducialMiss::None) {
+    count("fiducial_miss_" + to_string(miss));
+  }
+  close_frame(frame, m);
 }
 
 // The pad's corners in the tracker's box grown by the margin (and at least as large as the
@@ -622,14 +667,42 @@ std::optional<PadObservation> TrackNode::refine(const TrackState& s) {
   return pad;
 }
 
-void TrackNode::publish(const Frame& frame, const TrackState* s, double ms, const PadObservation* pad) {
+aerie::track_t TrackNode::track_message(const Frame& frame, const std::string& tracker, double ms) {
   aerie::track_t m{};
   m.utime = frame.image.utime;
   m.seq = seq_++;
-  m.tracker = tracker_name_;
+  m.tracker = tracker;
   m.camera = opt_.camera_channel;
   m.processing_ms = static_cast<float>(ms);
   m.frames_skipped = counter("frames_skipped");
+  return m;
+}
+
+void TrackNode::publish_pose(const aerie::track_t& m, const TargetPose& p, int8_t source) {
+  aerie::target_pose_t tp{};
+  tp.utime = m.utime;
+  tp.seq = pose_seq_++;
+  tp.target = opt_.target_name;
+  for (int i = 0; i < 3; ++i) tp.position[i] = p.position[i];
+  tp.yaw = p.yaw;
+  tp.confidence = m.confidence;
+  tp.source = source;
+  bus_.publish(opt_.pose_channel, tp);
+  count("poses_published");
+}
+
+void TrackNode::close_frame(const Frame& frame, const aerie::track_t& m) {
+  bus_.publish(opt_.track_channel, m);
+  count("tracks_published");
+
+  std::lock_guard lk(mutex_);
+  hop_source_ = m.utime;
+  hop_receive_ = frame.receive_utime;
+  hop_publish_ = util::wall_utime();
+}
+
+void TrackNode::publish(const Frame& frame, const TrackState* s, double ms, const PadObservation* pad) {
+  aerie::track_t m = track_message(frame, tracker_name_, ms);
   if (!s) {
     m.status = aerie::track_t::IDLE;
   } else {
@@ -672,28 +745,13 @@ void TrackNode::publish(const Frame& frame, const TrackState* s, double ms, cons
       TargetPose p = pad ? TargetPose{pad->position, pad->yaw} : target_pose(*s, *last_camera_, opt_.target);
       // A box tells nothing of a square pad's orientation: keep the last refined one.
       if (!pad && opt_.target_shape == TargetShape::Square && last_pad_yaw_) p.yaw = *last_pad_yaw_;
-      aerie::target_pose_t tp{};
-      tp.utime = m.utime;
-      tp.seq = pose_seq_++;
-      tp.target = opt_.target_name;
-      for (int i = 0; i < 3; ++i) tp.position[i] = p.position[i];
-      tp.yaw = p.yaw;
-      tp.confidence = m.confidence;
-      tp.source = pad ? aerie::target_pose_t::SOURCE_FIT : aerie::target_pose_t::SOURCE_BOX;
-      bus_.publish(opt_.pose_channel, tp);
-      count("poses_published");
+      publish_pose(m, p, pad ? aerie::target_pose_t::SOURCE_FIT : aerie::target_pose_t::SOURCE_BOX);
     } catch (const std::exception& e) {
       count("pose_errors");
       fail(opt_.pose_channel + ": " + e.what());
     }
   }
-  bus_.publish(opt_.track_channel, m);
-  count("tracks_published");
-
-  std::lock_guard lk(mutex_);
-  hop_source_ = m.utime;
-  hop_receive_ = frame.receive_utime;
-  hop_publish_ = util::wall_utime();
+  close_frame(frame, m);
 }
 
 }  // namespace aerie::track

@@ -33,6 +33,7 @@
 #include <string>
 #include <thread>
 
+#include "air/track/fiducial/fiducial.hpp"
 #include "air/track/landing/pad_pose.hpp"
 #include "air/track/node/default_tracker.hpp"
 #include "air/track/landing/target_pose.hpp"
@@ -72,6 +73,11 @@ struct NodeOptions {
   double reseed_iou = 0.5;     // square: re-initialise the tracker on the pad when their IoU is below (0 = never)
   bool fit_h_when_cut = false; // square: a pad cut by the image border gets the pose of its H alone (observe_marking)
   std::optional<camera::CameraModel> camera;  // intrinsics (stereo messages bring their own)
+  // target.pose_source apriltag | aruco: TRACK and TARGET_POSE come from the fiducial board of the
+  // "fiducial" section, detected in every whole frame (the online tracker is not run);
+  // tracker (default): from the tracker, as target.shape says.
+  std::optional<FiducialBoard> fiducial;
+  FiducialOptions fiducial_options;
   // message_time.*: the camera's time (docs/architecture.md "Message time"): a frame whose utime
   // jumps is held (never tracked, so a bogus time never reaches TRACK / TARGET_POSE), a restart or
   // outage re-synchronises, no frame for stale_timeout_s is reported as "<camera> stale".
@@ -130,9 +136,16 @@ class TrackNode {
   void run();
   void execute(const aerie::track_cmd_t& cmd);
   void process(const Frame& frame);
+  void process_fiducial(const Frame& frame);  // pose_source apriltag | aruco
   std::optional<PadObservation> refine(const TrackState& s);
   void start_tracker(const std::string& name, const util::Config& params, const cv::Rect2d& box);
   void publish(const Frame& frame, const TrackState* state, double ms, const PadObservation* pad = nullptr);
+  // TRACK of a frame: its header (utime, seq, tracker, camera, timing), and publishing it (which
+  // closes the frame: the last hop is recorded).
+  aerie::track_t track_message(const Frame& frame, const std::string& tracker, double ms);
+  void close_frame(const Frame& frame, const aerie::track_t& m);
+  // TARGET_POSE of the frame of `m` (its utime and confidence) with the given source.
+  void publish_pose(const aerie::track_t& m, const TargetPose& p, int8_t source);
   // Largest frame decoded: the configured camera's size (camera.width x camera.height), else image::kMaxPixels.
   int64_t max_pixels() const;
   void count(const std::string& name, int64_t n = 1);
@@ -172,6 +185,8 @@ class TrackNode {
   // The INIT waiting for the first frame: only the newest (a later INIT or a STOP supersedes it).
   std::optional<aerie::track_cmd_t> deferred_;
   std::unique_ptr<Tracker> tracker_;
+  std::unique_ptr<FiducialDetector> fiducial_;
+  bool fiducial_seen_ = false;  // since the start: an unseen board is LOST after, IDLE before
   std::string tracker_name_;
   util::Config tracker_params_;
   cv::Mat last_frame_;
