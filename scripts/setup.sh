@@ -11,7 +11,7 @@ PACKAGES=(
   libvtk9-dev mpi-default-dev xvfb xauth
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfuzzylite-dev libnlopt-cxx-dev libhwy-dev libsodium-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  iproute2 python3-numpy python3-matplotlib
+  iproute2 python3-numpy python3-matplotlib librsvg2-bin
 )
 
 missing=()
