@@ -8,6 +8,7 @@
 
 #include "tests/support/lockstep_bytes.hpp"
 #include "loop/landing.hpp"
+#include "tests/loop/landing/short_landing.hpp"
 
 using namespace aerie;
 
@@ -63,18 +64,9 @@ class LandingPerTracker : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LandingPerTracker, LandsOnThePad) {
   loop::landing::RunConfig rc = config(GetParam(), 2);
-  rc.sim.placement.start_distance_min_m = 0.5;
-  rc.sim.placement.start_distance_max_m = 1.0;
-  rc.pilot.survey_legs.clear();
+  loop::landing::test::start_close(rc);
   const loop::landing::RunResult r = loop::landing::fly(rc);
-  EXPECT_TRUE(r.outcome.landed) << r.final_state << " " << r.outcome.collision;
-  EXPECT_TRUE(r.score.success) << "touchdown error " << r.score.touchdown_error_m << " m, yaw " << r.score.yaw_error_deg;
-  EXPECT_LT(r.score.touchdown_error_m, 0.15);
-  EXPECT_EQ(r.final_state, "LANDED");
-  EXPECT_GT(r.descent.size(), 5u);
-  EXPECT_LT(r.rmse(0), 0.05);  // TARGET_POSE against the truth during the descent
-  EXPECT_LT(r.rmse(2), 0.05);
-  EXPECT_EQ(r.lockstep_timeouts, 0);
+  loop::landing::test::expect_landed_on_the_pad(r);
   EXPECT_EQ(r.commands_refused, 0);
 }
 
