@@ -1,47 +1,15 @@
 #include "air/mono/mono_config.hpp"
 
-#include <set>
 #include <stdexcept>
 
+#include "air/stereo/features/feature_keys.hpp"
+
 namespace aerie::mono {
-namespace {
-
-class Reader {
- public:
-  explicit Reader(const util::Config& cfg) : cfg_(cfg) {}
-  template <typename T>
-  void operator()(const std::string& key, T& value) {
-    known_.insert(key);
-    value = cfg_.get<T>(key, value);
-  }
-  void check_unknown(const std::vector<std::string>& other_sections) const {
-    std::vector<std::string> known(known_.begin(), known_.end());
-    for (const auto& s : other_sections) known.push_back(s + ".*");
-    cfg_.check_keys(known);
-  }
-
- private:
-  const util::Config& cfg_;
-  std::set<std::string> known_;
-};
-
-}  // namespace
 
 MonoParams mono_params_from_config(const util::Config& cfg, const std::vector<std::string>& other_sections) {
   MonoParams p;
-  Reader rd(cfg);
-  stereo::FeatureParams& f = p.features;
-  rd("features.buckets_x", f.buckets_x);
-  rd("features.buckets_y", f.buckets_y);
-  rd("features.margin_x", f.margin_x);
-  rd("features.margin_y", f.margin_y);
-  rd("features.max_per_bucket", f.max_per_bucket);
-  rd("features.fast_threshold", f.fast_threshold);
-  rd("features.min_fast_threshold", f.min_fast_threshold);
-  rd("features.smoothing_sigma", f.smoothing_sigma);
-  rd("features.patch_size", f.patch_size);
-  rd("features.descriptor_bits", f.descriptor_bits);
-  rd("features.pattern_seed", f.pattern_seed);
+  util::KeyReader rd(cfg);
+  stereo::read_feature_keys(rd, p.features);
 
   std::string mode = p.tracking == TrackingMode::Klt ? "klt" : "brief";
   rd("tracking.mode", mode);

@@ -1,36 +1,15 @@
 #include "air/stereo/vo/vo_config.hpp"
 
 #include <algorithm>
-#include <set>
 #include <stdexcept>
 
+#include "air/stereo/features/feature_keys.hpp"
+
 namespace aerie::stereo {
-namespace {
-
-class Reader {
- public:
-  explicit Reader(const util::Config& cfg) : cfg_(cfg) {}
-  template <typename T>
-  void operator()(const std::string& key, T& value) {
-    known_.insert(key);
-    value = cfg_.get<T>(key, value);
-  }
-  void check_unknown(const std::vector<std::string>& other_sections) const {
-    std::vector<std::string> known(known_.begin(), known_.end());
-    for (const auto& s : other_sections) known.push_back(s + ".*");  // read by their own readers
-    cfg_.check_keys(known);
-  }
-
- private:
-  const util::Config& cfg_;
-  std::set<std::string> known_;
-};
-
-}  // namespace
 
 VoParams vo_params_from_config(const util::Config& cfg, const std::vector<std::string>& other_sections) {
   VoParams p;
-  Reader rd(cfg);
+  util::KeyReader rd(cfg);
   SgmParams& s = p.depth.sgm;
   rd("depth.num_disparities", s.num_disparities);
   rd("depth.p1", s.p1);
@@ -50,19 +29,7 @@ VoParams vo_params_from_config(const util::Config& cfg, const std::vector<std::s
   rd("depth.refine_half_window", p.refine_half_window);
   rd("depth.max_depth_m", p.max_depth_m);
 
-  FeatureParams& f = p.features;
-  rd("features.buckets_x", f.buckets_x);
-  rd("features.buckets_y", f.buckets_y);
-  rd("features.margin_x", f.margin_x);
-  rd("features.margin_y", f.margin_y);
-  rd("features.max_per_bucket", f.max_per_bucket);
-  rd("features.fast_threshold", f.fast_threshold);
-  rd("features.min_fast_threshold", f.min_fast_threshold);
-  rd("features.smoothing_sigma", f.smoothing_sigma);
-  rd("features.subpixel", f.subpixel);
-  rd("features.patch_size", f.patch_size);
-  rd("features.descriptor_bits", f.descriptor_bits);
-  rd("features.pattern_seed", f.pattern_seed);
+  read_feature_keys(rd, p.features);
 
   rd("matching.max_distance", p.matching.max_distance);
   rd("matching.ratio", p.matching.ratio);
